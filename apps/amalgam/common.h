@@ -1,0 +1,43 @@
+#pragma once
+/// \file Options shared by the subcommands, and the error-to-exit-status rule.
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+#include "amalgam/builtin/params.h"
+#include "amalgam/math/vec.h"
+#include "amalgam/render/options.h"
+
+namespace amalgam::cli {
+
+/// Holds the text of the shared options until they are checked.
+struct CommonOptions {
+  std::string scene;
+  std::vector<std::string> sets;
+  std::string renderer = "scale-sensitive";
+  std::string opacity = "stochastic";
+  std::string order = "sorted";
+  int level = -1;
+  float footprint = 1.0f;
+  std::int64_t seed = 0;
+  int threads = 0;
+  RenderOptions options;
+
+  /// Registers SCENE, --set and the renderer options of CONTRACT.md on `app`.
+  void add_to(CLI::App& app);
+  /// Converts the parsed text into `options`; throws InputError on bad values.
+  void finish();
+  Params params() const;
+};
+
+/// Parses "x,y,z" into three floats; throws InputError naming the option.
+Vec3 parse_vec3(const std::string& text, const std::string& option);
+
+int run_render(CommonOptions& common, const std::string& out, const std::string& stats,
+               const std::string& cost_image);
+int run_trace(CommonOptions& common, const std::string& origin, const std::string& direction);
+int run_scenes();
+int run_experiment(const std::string& name, const std::string& out_dir, bool quick, int threads);
+
+}  // namespace amalgam::cli

@@ -1,0 +1,77 @@
+/// The `amalgam` command line: render, trace, scenes, experiment (see CONTRACT.md).
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <iostream>
+
+#include "amalgam/io/image.h"
+#include "common.h"
+
+int main(int argc, char** argv) {
+  using namespace amalgam;
+  CLI::App app{"amalgam: a ray tracer with renderable bounding volumes (amalgams), after "
+               "Thompson & Fussell, 'Time Costs of Ray Tracing with Amalgams' (1991)"};
+  app.require_subcommand(1);
+
+  cli::CommonOptions render_opts;
+  std::string out, stats, cost_image;
+  CLI::App* render = app.add_subcommand("render", "render an image and report exact costs");
+  render_opts.add_to(*render);
+  render->add_option("--out", out, "output image (.png, .exr or .pfm)")->required();
+  render->add_option("--stats", stats, "write the stats JSON to FILE, or - for stdout");
+  render->add_option("--cost-image", cost_image,
+                     "write intersection tests per pixel: false colour (.png) or raw (.exr/.pfm)");
+  render->add_option("--width", render_opts.options.width, "image width (default 512)")
+      ->check(CLI::PositiveNumber);
+  render->add_option("--height", render_opts.options.height, "image height (default 512)")
+      ->check(CLI::PositiveNumber);
+  render->add_option("--spp", render_opts.options.spp, "samples per pixel (default 4)")
+      ->check(CLI::PositiveNumber);
+
+  cli::CommonOptions trace_opts;
+  std::string origin, direction;
+  CLI::App* trace = app.add_subcommand(
+      "trace", "trace one primary ray (default: the scene's centre ray) and print its costs");
+  trace_opts.add_to(*trace);
+  trace->add_option("--origin", origin, "ray origin x,y,z");
+  trace->add_option("--direction", direction, "ray direction x,y,z");
+
+  app.add_subcommand("scenes", "list the builtin scenes and their parameters");
+
+  std::string exp_name, exp_out;
+  bool exp_quick = false;
+  int exp_threads = 0;
+  CLI::App* experiment = app.add_subcommand(
+      "experiment", "reproduce the paper's analyses as measured sweeps (NAME or all)");
+  experiment->add_option("name", exp_name, "experiment name, or all")->required();
+  experiment->add_option("--out", exp_out, "output directory")->required();
+  experiment->add_flag("--quick", exp_quick, "small sizes (as the tests use)");
+  experiment->add_option("--threads", exp_threads, "worker threads (default: all cores)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "amalgam: " << e.what() << " (see 'amalgam --help')\n";
+    return 2;
+  }
+
+  try {
+    if (render->parsed()) return cli::run_render(render_opts, out, stats, cost_image);
+    if (trace->parsed()) return cli::run_trace(trace_opts, origin, direction);
+    if (experiment->parsed()) return cli::run_experiment(exp_name, exp_out, exp_quick, exp_threads);
+    return cli::run_scenes();
+  } catch (const InputError& e) {
+    std::cerr << "amalgam: " << e.what() << "\n";
+    return 2;
+  } catch (const ImageIoError& e) {
+    std::cerr << "amalgam: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "amalgam: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,42 @@
+#pragma once
+/// \file `--set key=value` parameters of the builtin scenes, checked and typed.
+
+#include <cstdint>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+namespace amalgam {
+
+/// Thrown for bad user input; the CLI turns it into one line on stderr and exit status 2.
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// The key=value pairs given with --set. Each builtin reads the keys it knows with a default
+/// and then calls `check_all_used`, so a misspelt key is an error, not silently ignored.
+class Params {
+ public:
+  Params() = default;
+  explicit Params(std::string scene) : scene_(std::move(scene)) {}
+  /// Parses "key=value"; throws InputError naming the text when it is not of that form.
+  void set(const std::string& key_value);
+  void set(const std::string& key, const std::string& value) { values_[key] = value; }
+
+  std::int64_t get_int(const std::string& key, std::int64_t def, std::int64_t lo,
+                       std::int64_t hi) const;
+  double get_double(const std::string& key, double def, double lo, double hi) const;
+  std::string get_choice(const std::string& key, const std::string& def,
+                         const std::set<std::string>& allowed) const;
+  /// Throws InputError for any key never read by a get_*.
+  void check_all_used() const;
+  bool has(const std::string& key) const { return values_.count(key) != 0; }
+
+ private:
+  std::string scene_;
+  std::map<std::string, std::string> values_;
+  mutable std::set<std::string> used_;
+};
+
+}  // namespace amalgam

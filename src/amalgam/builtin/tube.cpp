@@ -1,0 +1,75 @@
+#include "amalgam/builtin/tube.h"
+
+#include <cmath>
+
+#include "amalgam/math/random.h"
+
+namespace amalgam {
+
+TubeHierarchy::TubeHierarchy(const Config& c) : c_(c) {
+  count_[0] = 1;
+  for (int l = 1; l <= c_.depth; ++l) count_[l] = count_[l - 1] * static_cast<std::uint64_t>(c_.n);
+  for (int l = 0; l <= c_.depth; ++l)
+    width_[l] = static_cast<double>(count_[c_.depth]) / static_cast<double>(count_[l]);
+  // The line ends at x = 0, where coordinates are most precise: the hit primitive and the
+  // origins of the shadow rays lie near the end of the line.
+  x0_ = -width_[0];
+}
+
+bool TubeHierarchy::on_axis(PrimId k) const {
+  if (c_.mode == Mode::kLine) return k + 1 == count_[c_.depth];
+  // Poisson: hits per unit cell are Bernoulli(q) with q = 1 - exp(-p / n^l_max), so the
+  // probability of no hit in a level-l node is exactly exp(-p / n^l).
+  const double q = -std::expm1(-c_.p / static_cast<double>(count_[c_.depth]));
+  const double u = static_cast<double>(mix64(hash_combine(c_.seed, k)) >> 11) * 0x1.0p-53;
+  return u < q;
+}
+
+Appearance TubeHierarchy::appearance(NodeId id) const {
+  const int l = level_of(id);
+  const std::uint64_t k = index_of(id);
+  Appearance a;
+  const float hue = static_cast<float>((static_cast<double>(k) + 0.5) / count_[l]);
+  a.surface.colour = {0.3f + 0.6f * hue, 0.5f, 0.9f - 0.6f * hue};
+  if (c_.mode == Mode::kLine)
+    a.opacity = (k + 1 == count_[l]) ? 1.0f : static_cast<float>(c_.alpha);
+  else
+    a.opacity = static_cast<float>(-std::expm1(-c_.p / static_cast<double>(count_[l])));
+  return a;
+}
+
+Surface TubeHierarchy::surface(PrimId k) const {
+  Surface s;
+  const float hue = static_cast<float>((static_cast<double>(k) + 0.5) / count_[c_.depth]);
+  s.colour = {0.3f + 0.6f * hue, 0.5f, 0.9f - 0.6f * hue};
+  return s;
+}
+
+HierarchyInfo TubeHierarchy::info() const {
+  HierarchyInfo i;
+  i.primitives = static_cast<double>(count_[c_.depth]);
+  for (int l = 0; l < c_.depth; ++l) i.nodes += static_cast<double>(count_[l]);
+  i.levels = c_.depth + 1;
+  return i;
+}
+
+Environment TubeHierarchy::environment(int lights) const {
+  Environment e;
+  const float cam = static_cast<float>(2.0 * x0_);
+  e.camera.position = {cam, 0, 0};
+  e.camera.look_at = {0, 0, 0};
+  e.camera.up = {0, 1, 0};
+  e.camera.vfov_deg = 10.0f;
+  const double far = 2.0 * width_[0];
+  for (int i = 0; i < lights; ++i) {
+    Light l;
+    l.kind = LightKind::kPoint;
+    l.position = {cam, 0, 0};
+    const float s = static_cast<float>(far * far) / static_cast<float>(lights);
+    l.intensity = {s, s, s};
+    e.lights.push_back(l);
+  }
+  return e;
+}
+
+}  // namespace amalgam

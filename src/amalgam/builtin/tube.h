@@ -1,0 +1,90 @@
+#pragma once
+/// \file The implicit "tube" hierarchy behind builtin:line (the paper's Figure 3) and
+/// builtin:poisson (the expected-case model of Eq. 9).
+///
+/// Nodes are nested intervals along the x axis: node k on level l spans
+/// [x0 + k w_l, x0 + (k + 1) w_l] x [-1/2, 1/2]^2 with w_l = n^(l_max - l) and x0 = -n^l_max
+/// (the line ends at x = 0, where floats are finest); each node has n
+/// children; leaf cells (level l_max - 1 nodes) hold n primitives, one per unit cell. Each
+/// primitive is a sphere of radius 0.2, either on the x axis (the default primary ray hits
+/// it) or 0.3 off it (the ray misses it). The camera and a point light sit on the axis at
+/// x = 2 x0, so the default ray and its shadow ray examine the whole line.
+
+#include <cmath>
+#include <cstdint>
+
+#include "amalgam/builtin/params.h"
+#include "amalgam/hierarchy/hierarchy.h"
+#include "amalgam/stats/counters.h"
+
+namespace amalgam {
+
+class TubeHierarchy {
+ public:
+  enum class Mode { kLine, kPoisson };
+
+  struct Config {
+    Mode mode = Mode::kLine;
+    int n = 3;               ///< children per node
+    int depth = 6;           ///< l_max: primitives live on level l_max
+    double alpha = 0.0;      ///< line: opacity of amalgams not holding the hit primitive
+    double p = 64.0;         ///< poisson: expected hits along the axis through the scene
+    std::uint64_t seed = 0;  ///< poisson: which realisation of the process
+  };
+
+  explicit TubeHierarchy(const Config& c);
+
+  NodeId root() const { return encode(0, 0); }
+  Bbox bounds(NodeId id) const {
+    const int l = level_of(id);
+    const double w = width_[l];
+    const double lo = x0_ + static_cast<double>(index_of(id)) * w;
+    return Bbox{{static_cast<float>(lo), -0.5f, -0.5f}, {static_cast<float>(lo + w), 0.5f, 0.5f}};
+  }
+  Appearance appearance(NodeId id) const;
+  template <class F>
+  void for_each_child(NodeId id, F&& f) const {
+    const int l = level_of(id);
+    const std::uint64_t first = index_of(id) * static_cast<std::uint64_t>(c_.n);
+    const bool prims = l + 1 == c_.depth;
+    for (int j = 0; j < c_.n; ++j) {
+      if (prims) {
+        if (!f(Child{first + j, true})) return;
+      } else if (!f(Child{encode(l + 1, first + j), false})) {
+        return;
+      }
+    }
+  }
+  std::optional<SurfaceHit> intersect(PrimId k, const Ray& ray) const {
+    return intersect_sphere(ray, prim_centre(k), 0.2f);
+  }
+  Surface surface(PrimId k) const;
+  Primitive primitive(PrimId k) const { return Primitive::sphere(prim_centre(k), 0.2f); }
+  HierarchyInfo info() const;
+
+  /// True when primitive k lies on the axis (is hit by the default ray).
+  bool on_axis(PrimId k) const;
+  Vec3 prim_centre(PrimId k) const {
+    return {static_cast<float>(x0_ + static_cast<double>(k) + 0.5), on_axis(k) ? 0.0f : 0.3f,
+            0.0f};
+  }
+  const Config& config() const { return c_; }
+  /// Number of primitives, n^l_max.
+  std::uint64_t primitive_count() const { return count_[c_.depth]; }
+  /// The environment: camera at the origin looking down +x, point light(s) at the camera.
+  Environment environment(int lights) const;
+
+  static constexpr int level_of(NodeId id) { return static_cast<int>(id >> 58); }
+  static constexpr std::uint64_t index_of(NodeId id) { return id & ((1ull << 58) - 1); }
+  static constexpr NodeId encode(int level, std::uint64_t index) {
+    return (static_cast<std::uint64_t>(level) << 58) | index;
+  }
+
+ private:
+  Config c_;
+  double x0_ = -1.0;
+  double width_[kMaxLevels]{};
+  std::uint64_t count_[kMaxLevels]{};
+};
+
+}  // namespace amalgam

@@ -1,0 +1,50 @@
+#pragma once
+// Implementation of amalgam::flatten (included from explicit.h).
+
+#include <functional>
+
+namespace amalgam {
+
+template <Hierarchy H>
+ExplicitHierarchy flatten(const H& src, int max_levels) {
+  ExplicitHierarchy out;
+  out.levels = max_levels;
+  // Breadth-first so that each node's children are contiguous.
+  struct Item {
+    NodeId src;
+    std::uint32_t dst;
+  };
+  std::vector<Item> queue{{src.root(), 0}};
+  out.nodes.push_back({src.bounds(src.root()), 0, 0, false});
+  out.appearances.push_back(src.appearance(src.root()));
+  for (std::size_t q = 0; q < queue.size(); ++q) {
+    const Item it = queue[q];
+    std::vector<Child> kids;
+    src.for_each_child(it.src, [&](Child c) {
+      kids.push_back(c);
+      return true;
+    });
+    ExplicitNode& node = out.nodes[it.dst];
+    node.count = static_cast<std::uint16_t>(kids.size());
+    node.leaf = !kids.empty() && kids.front().is_primitive;
+    if (node.leaf) {
+      node.first = static_cast<std::uint32_t>(out.prims.size());
+      for (const Child& c : kids) {
+        Primitive p = src.primitive(c.id);
+        p.material = static_cast<std::uint32_t>(out.materials.size());
+        out.materials.push_back(src.surface(c.id));
+        out.prims.push_back(p);
+      }
+    } else {
+      node.first = static_cast<std::uint32_t>(out.nodes.size());
+      for (const Child& c : kids) {
+        queue.push_back({c.id, static_cast<std::uint32_t>(out.nodes.size())});
+        out.nodes.push_back({src.bounds(c.id), 0, 0, false});
+        out.appearances.push_back(src.appearance(c.id));
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace amalgam

@@ -1,0 +1,49 @@
+#pragma once
+/// \file Image and text output (PNG, PFM, OpenEXR), image input, and false-colour mapping.
+///
+/// All writers are atomic: data goes to a temporary file in the destination directory
+/// (`<path>.tmp-<pid>-<n>`), which is flushed, synced and then renamed onto `path`. On any
+/// failure the temporary is removed and an ImageIoError is thrown, so `path` is either left
+/// untouched or holds a complete file.
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "amalgam/math/vec.h"
+
+namespace amalgam {
+
+/// Thrown by every function here on failure. what() is one line naming the file and the reason.
+struct ImageIoError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Writes a width x height image; pixel (x, y) is linear_rgb[y * width + x], y = 0 the top row.
+/// The format follows the extension of `path` (case-insensitive):
+///   .png  8-bit sRGB (values clamped to [0, 1], sRGB transfer function, rounded);
+///   .pfm  little-endian 32-bit float RGB ("PF", scale -1.0, rows stored bottom-to-top);
+///   .exr  half-float RGB (OpenEXR, ZIP compression, no alpha channel, i.e. opaque).
+/// Throws ImageIoError for any other extension, for a size mismatch, or on any I/O error.
+void write_image(const std::string& path, int width, int height,
+                 const std::vector<Vec3>& linear_rgb);
+
+/// Reads a .png (8/16-bit grey, grey+alpha, RGB, RGBA or palette; alpha is ignored and sRGB
+/// is decoded to linear), .pfm (colour "PF" or grey "Pf", either endianness; the magnitude of
+/// the scale is ignored) or .exr (via the RGBA interface; alpha ignored) file. Sets width and
+/// height and returns pixels in the same layout write_image takes. Throws ImageIoError naming
+/// the file on any error.
+std::vector<Vec3> read_image(const std::string& path, int& width, int& height);
+
+/// Maps non-negative values (e.g. intersection tests per pixel) to the viridis colour map, in
+/// linear RGB (so write_image's sRGB encoding displays the published colours). Values are
+/// normalised by the largest finite value, after log1p when log_scale is set; negative and NaN
+/// values map to the low end, +inf to the high end. Luminance increases with the value.
+/// Writes that largest finite value (0 if no value is positive) to *vmax_out when not null.
+std::vector<Vec3> false_colour(const std::vector<double>& values, bool log_scale,
+                               double* vmax_out = nullptr);
+
+/// Writes `contents` to `path` with the same temporary-file-and-rename rule as write_image.
+void write_text_atomic(const std::string& path, const std::string& contents);
+
+}  // namespace amalgam

@@ -1,0 +1,25 @@
+#pragma once
+/// \file Local shading: Lambertian diffuse plus a normalised Blinn-Phong lobe.
+
+#include <numbers>
+
+#include "amalgam/scene/scene.h"
+
+namespace amalgam {
+
+/// Reflected radiance factor for light arriving from `wi`, seen from `wo` (both unit, pointing
+/// away from the surface), with shading normal `n`.
+inline Vec3 brdf(const Surface& s, Vec3 n, Vec3 wi, Vec3 wo) {
+  constexpr float inv_pi = std::numbers::inv_pi_v<float>;
+  Vec3 f = s.colour * inv_pi;
+  if (s.reflectance > 0.0f) {
+    const Vec3 h = normalize(wi + wo);
+    const float c = std::max(0.0f, dot(n, h));
+    const float spec = s.reflectance * (s.shininess + 8.0f) * (inv_pi / 8.0f) *
+                       std::pow(c, s.shininess);
+    f += Vec3{spec, spec, spec};
+  }
+  return f;
+}
+
+}  // namespace amalgam

@@ -1,0 +1,90 @@
+#pragma once
+/// \file What a user describes: surfaces, primitives, lights, camera.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "amalgam/geometry/bbox.h"
+#include "amalgam/geometry/intersect.h"
+
+namespace amalgam {
+
+/// How a surface reflects light: Lambertian diffuse plus a normalised Blinn-Phong lobe.
+/// No mirror or refraction rays are ever spawned (the paper's setting).
+struct Surface {
+  Vec3 colour{0.8f, 0.8f, 0.8f};  ///< diffuse albedo, linear RGB
+  float reflectance = 0.0f;       ///< specular weight in [0, 1]
+  float shininess = 32.0f;        ///< Blinn-Phong exponent
+};
+
+/// The visual attributes of an amalgam: a surface, an opacity, and optionally a shading
+/// normal (zero means "use the normal of the box face the ray enters").
+struct Appearance {
+  Surface surface;
+  float opacity = 1.0f;  ///< probability that a ray crossing the amalgam hits its contents
+  Vec3 normal{};
+};
+
+enum class PrimKind : std::uint8_t { kTriangle, kSphere, kBox };
+
+/// One primitive. Triangle: a, b, c. Sphere: centre a, radius. Box: corners a (lo), b (hi).
+struct Primitive {
+  PrimKind kind = PrimKind::kTriangle;
+  std::uint32_t material = 0;
+  Vec3 a, b, c;
+  float radius = 0.0f;
+
+  static Primitive triangle(Vec3 a, Vec3 b, Vec3 c, std::uint32_t m = 0) {
+    return {PrimKind::kTriangle, m, a, b, c, 0.0f};
+  }
+  static Primitive sphere(Vec3 centre, float r, std::uint32_t m = 0) {
+    return {PrimKind::kSphere, m, centre, {}, {}, r};
+  }
+  static Primitive box(Vec3 lo, Vec3 hi, std::uint32_t m = 0) {
+    return {PrimKind::kBox, m, min(lo, hi), max(lo, hi), {}, 0.0f};
+  }
+};
+
+/// Ray/primitive test (one intersection test in the paper's sense).
+std::optional<SurfaceHit> intersect(const Primitive& prim, const Ray& ray);
+/// Tight bounds of a primitive.
+Bbox bounds(const Primitive& prim);
+/// Mean projected area over all directions (Cauchy: surface area / 4 for convex bodies; a
+/// triangle, seen from both sides, projects area/2 on average).
+float mean_projected_area(const Primitive& prim);
+
+enum class LightKind : std::uint8_t { kPoint, kDirectional };
+
+/// A point light (position, intensity in W/sr) or a directional light (direction the light
+/// travels, irradiance).
+struct Light {
+  LightKind kind = LightKind::kPoint;
+  Vec3 position{};
+  Vec3 direction{0, -1, 0};
+  Vec3 intensity{1, 1, 1};
+};
+
+/// A pinhole camera.
+struct Camera {
+  Vec3 position{0, 0, 5};
+  Vec3 look_at{0, 0, 0};
+  Vec3 up{0, 1, 0};
+  float vfov_deg = 45.0f;
+
+  /// The ray through film position (fx, fy) in pixels, (0, 0) being the top-left corner of
+  /// a width x height film. The ray carries a cone of one pixel's angular size.
+  Ray generate(float fx, float fy, int width, int height) const;
+  /// The ray through the film centre: the scene's default ray for `trace`.
+  Ray centre_ray(int width, int height) const { return generate(width * 0.5f, height * 0.5f, width, height); }
+};
+
+/// Lights, camera and background: everything but the geometry.
+struct Environment {
+  std::vector<Light> lights;
+  Camera camera;
+  Vec3 background{0.05f, 0.05f, 0.08f};
+};
+
+}  // namespace amalgam

@@ -1,0 +1,47 @@
+#pragma once
+/// \file Exact intersection-test counters, as the paper counts cost (one unit per ray/object
+/// test of a primitive, bounding volume or amalgam). One `Counters` per thread; merged at the
+/// end. Plain increments, no atomics.
+
+#include <array>
+#include <cstdint>
+
+namespace amalgam {
+
+enum class RayKind : std::uint8_t { kPrimary = 0, kShadow = 1 };
+/// What was tested: a primitive; a node tested only as a container (bounding volume); or a
+/// node the renderer may render (amalgam).
+enum class ObjectKind : std::uint8_t { kPrimitive = 0, kBoundingVolume = 1, kAmalgam = 2 };
+
+inline constexpr int kMaxLevels = 64;
+
+struct Counters {
+  /// tests[ray kind][object kind]
+  std::array<std::array<std::uint64_t, 3>, 2> tests{};
+  std::array<std::uint64_t, kMaxLevels> by_level{};
+  std::array<std::uint64_t, 2> rays{};
+
+  void count_test(RayKind r, ObjectKind o, int level) {
+    ++tests[static_cast<int>(r)][static_cast<int>(o)];
+    ++by_level[static_cast<unsigned>(level) < kMaxLevels ? level : kMaxLevels - 1];
+  }
+  void count_ray(RayKind r) { ++rays[static_cast<int>(r)]; }
+
+  std::uint64_t tests_of(RayKind r) const {
+    const auto& t = tests[static_cast<int>(r)];
+    return t[0] + t[1] + t[2];
+  }
+  std::uint64_t tests_of(ObjectKind o) const {
+    return tests[0][static_cast<int>(o)] + tests[1][static_cast<int>(o)];
+  }
+  std::uint64_t total() const { return tests_of(RayKind::kPrimary) + tests_of(RayKind::kShadow); }
+
+  void merge(const Counters& o) {
+    for (int r = 0; r < 2; ++r)
+      for (int k = 0; k < 3; ++k) tests[r][k] += o.tests[r][k];
+    for (int l = 0; l < kMaxLevels; ++l) by_level[l] += o.by_level[l];
+    for (int r = 0; r < 2; ++r) rays[r] += o.rays[r];
+  }
+};
+
+}  // namespace amalgam
