@@ -19,10 +19,10 @@ struct SampleResult {
   TraceHit hit;
 };
 
-template <Hierarchy H, class Lod, OpacityModel kOpacity, bool kSorted>
+template <Hierarchy H, class Lod, OpacityModel kOpacity, bool kSorted, class Stats = Counters>
 class Integrator {
  public:
-  Integrator(const H& h, const Environment& env, const Lod& lod, Counters& counters)
+  Integrator(const H& h, const Environment& env, const Lod& lod, Stats& counters)
       : h_(h), env_(env), trav_(h, lod, counters) {}
 
   /// Radiance along `primary`; `key` derives every random decision of this sample.
@@ -100,7 +100,7 @@ class Integrator {
 
   const H& h_;
   const Environment& env_;
-  Traversal<H, Lod, kOpacity, kSorted> trav_;
+  Traversal<H, Lod, kOpacity, kSorted, Stats> trav_;
   std::vector<TranslucentHit> translucent_;
 };
 

@@ -44,4 +44,11 @@ struct Counters {
   }
 };
 
+/// The Counters interface with every operation a no-op: the compiler removes the counting.
+struct NullCounters {
+  void count_test(RayKind, ObjectKind, int) {}
+  void count_ray(RayKind) {}
+  std::uint64_t total() const { return 0; }
+};
+
 }  // namespace amalgam

@@ -48,10 +48,12 @@ struct TranslucentHit {
 
 enum class OpacityModel : std::uint8_t { kStochastic, kDeterministic };
 
-template <Hierarchy H, class Lod, OpacityModel kOpacity, bool kSorted>
+/// `Stats` is Counters (exact counts) or NullCounters (counting compiled out, to measure the
+/// counters' own overhead).
+template <Hierarchy H, class Lod, OpacityModel kOpacity, bool kSorted, class Stats = Counters>
 class Traversal {
  public:
-  Traversal(const H& h, const Lod& lod, Counters& counters)
+  Traversal(const H& h, const Lod& lod, Stats& counters)
       : h_(h), lod_(lod), counters_(counters) {}
 
   /// Closest hit along `ray`. `key` seeds this ray's stochastic decisions. Under
@@ -187,7 +189,7 @@ class Traversal {
 
   const H& h_;
   Lod lod_;
-  Counters& counters_;
+  Stats& counters_;
   Ray ray_;
   std::uint64_t key_ = 0;
   RayKind kind_ = RayKind::kPrimary;

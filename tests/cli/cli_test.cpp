@@ -1,0 +1,146 @@
+// End-to-end tests of the `amalgam` binary: the outside contract of CONTRACT.md.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int status;
+  std::string out;
+};
+
+// Runs the binary with `args` (a shell-quoted string); stdout captured, stderr to err_file.
+CliRun run(const std::string& args, const std::string& err_file = "/dev/null") {
+  const std::string cmd = std::string(AMALGAM_BINARY) + " " + args + " 2>" + err_file;
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  std::size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+fs::path temp_dir() {
+  const fs::path d = fs::temp_directory_path() / ("amalgam-cli-" + std::to_string(getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+TEST(Cli, TraceLineTraditionalIsTheWorstCase) {
+  const CliRun r = run("trace builtin:line --set n=3 --set depth=6 --renderer traditional");
+  ASSERT_EQ(r.status, 0);
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["tests"]["primary"], 1093);
+  EXPECT_EQ(j["tests"]["shadow"], 1093);
+  EXPECT_EQ(j["scene"]["levels"], 7);
+  EXPECT_EQ(j["hit"]["object"]["kind"], "primitive");
+  EXPECT_TRUE(j["level"].is_null());
+}
+
+TEST(Cli, RenderWritesImageCostImageAndStats) {
+  const fs::path d = temp_dir();
+  const CliRun r = run("render builtin:prisms --set depth=4 --level 2 --width 40 --height 30 --spp 2 "
+                    "--out " + (d / "a.png").string() + " --cost-image " +
+                    (d / "c.png").string() + " --stats " + (d / "s.json").string());
+  ASSERT_EQ(r.status, 0);
+  EXPECT_GT(fs::file_size(d / "a.png"), 100u);
+  EXPECT_GT(fs::file_size(d / "c.png"), 100u);
+  std::ifstream in(d / "s.json");
+  const auto j = nlohmann::json::parse(in);
+  for (const char* key : {"renderer", "opacity", "level", "footprint", "scene", "rays", "tests",
+                          "per_primary_ray", "time_s"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["renderer"], "scale-sensitive");
+  EXPECT_EQ(j["level"], 2);
+  const auto& t = j["tests"];
+  std::uint64_t levels = 0;
+  for (const auto& v : t["by_level"]) levels += v.get<std::uint64_t>();
+  EXPECT_EQ(t["primary"].get<std::uint64_t>() + t["shadow"].get<std::uint64_t>(), t["total"]);
+  EXPECT_EQ(t["primitive"].get<std::uint64_t>() + t["bounding_volume"].get<std::uint64_t>() +
+                t["amalgam"].get<std::uint64_t>(),
+            t["total"]);
+  EXPECT_EQ(levels, t["total"]);
+  EXPECT_EQ(j["rays"]["primary"], 40 * 30 * 2);
+  fs::remove_all(d);
+}
+
+TEST(Cli, StatsToStdout) {
+  const fs::path d = temp_dir();
+  const CliRun r = run("render builtin:line --width 8 --height 8 --spp 1 --out " +
+                    (d / "l.pfm").string() + " --stats -");
+  ASSERT_EQ(r.status, 0);
+  EXPECT_EQ(nlohmann::json::parse(r.out)["rays"]["primary"], 64);
+  fs::remove_all(d);
+}
+
+struct BadCase {
+  const char* args;
+  const char* expect_in_message;
+};
+
+TEST(Cli, BadInputExitsTwoWithOneLineAndNoOutput) {
+  const fs::path d = temp_dir();
+  const std::string out = (d / "never.png").string();
+  const BadCase cases[] = {
+      {"render builtin:line --renderer fast", "--renderer"},
+      {"render builtin:line --opacity maybe", "--opacity"},
+      {"render builtin:line --level 9", "--level 9"},
+      {"render builtin:line --level -1", "--level"},
+      {"render builtin:line --footprint 0", "--footprint"},
+      {"render builtin:line --set n=1", "n=1"},
+      {"render builtin:line --set bogus=3", "bogus"},
+      {"render builtin:line --set depth", "depth"},
+      {"render builtin:nothing", "builtin:nothing"},
+      {"render /no/such/scene.json", "/no/such/scene.json"},
+      {"render builtin:line --width 0", "--width"},
+      {"render builtin:prisms --set view=side", "view=side"},
+      {"render builtin:line --set n=8 --set depth=30", "2^58"},
+      {"render builtin:line --order random", "--order"},
+  };
+  for (const BadCase& c : cases) {
+    const std::string err = (d / "err.txt").string();
+    const CliRun r = run(std::string(c.args) + " --out " + out, err);
+    EXPECT_EQ(r.status, 2) << c.args;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+    std::ifstream in(err);
+    std::string line, rest;
+    std::getline(in, line);
+    EXPECT_NE(line.find(c.expect_in_message), std::string::npos) << c.args << " -> " << line;
+    EXPECT_FALSE(std::getline(in, rest)) << "one line only: " << c.args;
+  }
+  const CliRun t = run("trace builtin:line --origin 1,2", (d / "err.txt").string());
+  EXPECT_EQ(t.status, 2);
+  EXPECT_EQ(run("render builtin:line").status, 2) << "--out is required";
+  EXPECT_EQ(run("").status, 2) << "a subcommand is required";
+  fs::remove_all(d);
+}
+
+TEST(Cli, UnwritableOutputIsARuntimeFailureWithoutPartialFiles) {
+  const CliRun r = run("render builtin:line --width 4 --height 4 --out /no/such/dir/x.png");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_FALSE(fs::exists("/no/such/dir/x.png"));
+}
+
+TEST(Cli, HelpForEverySubcommand) {
+  for (const char* sub : {"", "render", "trace", "scenes", "experiment"}) {
+    const CliRun r = run(std::string(sub) + " --help");
+    EXPECT_EQ(r.status, 0) << sub;
+    EXPECT_NE(r.out.find("Usage"), std::string::npos) << sub;
+  }
+  const CliRun s = run("scenes");
+  EXPECT_EQ(s.status, 0);
+  for (const char* name : {"builtin:line", "builtin:prisms", "builtin:poisson", "builtin:demo"})
+    EXPECT_NE(s.out.find(name), std::string::npos) << name;
+}
+
+}  // namespace
