@@ -31,6 +31,14 @@ struct Table {
 /// One curve of a plot: column `y` against column `x`, optionally only the rows whose column
 /// `filter` equals `filter_value`.
 struct Series {
+  Series(std::string x_, std::string y_, std::string title_, bool lines_ = false,
+         std::string filter_ = "", double filter_value_ = 0)
+      : x(std::move(x_)),
+        y(std::move(y_)),
+        title(std::move(title_)),
+        lines(lines_),
+        filter(std::move(filter_)),
+        filter_value(filter_value_) {}
   std::string x, y, title;
   bool lines = false;  ///< lines (a prediction) or points (a measurement)
   std::string filter;
@@ -55,11 +63,11 @@ enum class Verdict { kHolds, kHoldsWithCorrection, kDoesNotHold };
 const char* to_string(Verdict v);
 
 struct ExperimentResult {
-  std::string name;        ///< e.g. "worst-traditional"
-  std::string title;       ///< section heading
-  std::string claim;       ///< what the paper says (markdown)
-  std::string prediction;  ///< the formula(s) used (markdown)
-  Table table;             ///< everything measured, written to <name>.csv
+  std::string name;                          ///< e.g. "worst-traditional"
+  std::string title;                         ///< section heading
+  std::string claim;                         ///< what the paper says (markdown)
+  std::string prediction;                    ///< the formula(s) used (markdown)
+  Table table;                               ///< everything measured, written to <name>.csv
   std::vector<std::string> summary_columns;  ///< the report's short table (subset of columns)
   std::vector<std::size_t> summary_rows;     ///< rows shown in the report (empty: up to 12)
   std::vector<Panel> panels;                 ///< the PNG (panels side by side)

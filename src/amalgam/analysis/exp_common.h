@@ -1,0 +1,61 @@
+#pragma once
+/// \file Helpers shared by the experiment sources (exp_*.cpp): scene loading and tracing of
+/// the default (centre) ray.
+
+#include <chrono>
+#include <string>
+
+#include "amalgam/analysis/experiments.h"
+#include "amalgam/render/render.h"
+
+namespace amalgam::experiments::detail {
+
+/// Loads builtin:`name` with the given key=value parameters.
+inline LoadedScene scene(const std::string& name,
+                         std::initializer_list<std::pair<std::string, std::string>> kv) {
+  Params p("builtin:" + name);
+  for (const auto& [k, v] : kv) p.set(k, v);
+  return load_scene("builtin:" + name, p);
+}
+
+inline std::string str(double v) {
+  return fmt(v);
+}
+
+/// Traces the scene's default ray (the centre pixel's ray of `trace`).
+inline TraceOutput trace_centre(const LoadedScene& s, const RenderOptions& o) {
+  return trace(s, o, s.env.camera.centre_ray(o.width, o.height));
+}
+
+inline RenderOptions traditional() {
+  RenderOptions o;
+  o.renderer = RendererKind::kTraditional;
+  return o;
+}
+
+inline RenderOptions at_level(int l1, OpacityKind op = OpacityKind::kStochastic) {
+  RenderOptions o;
+  o.level = l1;
+  o.opacity = op;
+  return o;
+}
+
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+inline double u(std::uint64_t v) {
+  return static_cast<double>(v);
+}
+
+/// Exact shadow tests of deterministic opacity on builtin:line (alpha < 1) at level l1:
+/// b + n sum_{m=0}^{l1-1} (b (n^m + 1)/2 - n^m), b = n^l1 (tests/traverse/paper_counts_test).
+inline double line_deterministic_shadow(int n, int l1) {
+  double b = 1;
+  for (int i = 0; i < l1; ++i) b *= n;
+  double total = b, nm = 1;
+  for (int m = 0; m < l1; ++m, nm *= n) total += n * (b * (nm + 1) / 2 - nm);
+  return total;
+}
+
+}  // namespace amalgam::experiments::detail

@@ -1,0 +1,263 @@
+/// \file The expected-case experiment on builtin:poisson (Eqs. 8-13).
+
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "amalgam/analysis/exp_common.h"
+#include "amalgam/analysis/formulas.h"
+#include "amalgam/builtin/tube.h"
+
+namespace amalgam::experiments {
+using namespace detail;
+
+namespace {
+
+double safe(const std::function<double()>& f) {
+  try {
+    const double v = f();
+    return std::isfinite(v) ? v : std::numeric_limits<double>::quiet_NaN();
+  } catch (const std::exception&) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+struct Mean {
+  double sum = 0, sum2 = 0;
+  int count = 0;
+  void add(double v) { sum += v, sum2 += v * v, ++count; }
+  double mean() const { return sum / count; }
+  double se() const {
+    const double m = mean();
+    const double var = std::max(0.0, (sum2 / count - m * m)) * count / std::max(1, count - 1);
+    return std::sqrt(var / count);
+  }
+};
+
+}  // namespace
+
+ExperimentResult expected(const Config& c) {
+  ExperimentResult r;
+  r.title = "Expected case: the Poisson model, sorted traversal (Eqs. 8-13)";
+  r.claim =
+      "With hits along the ray a Poisson process and a sorted traversal, the number of "
+      "amalgams visited on level l1 has the mean of Eq. 9. For the traditional renderer "
+      "(l1 = l_max - 1, p/b = n) this is Eq. 10, whose large-p limit Eq. 12 states as "
+      "(1 - e^{-n}) = O(1); for the scale-sensitive renderer with b fixed it is Eq. 13, "
+      "O(1). The overall cost (Eq. 8) is dominated by the logarithmic term: O(log p) for "
+      "the traditional renderer and O(log b) for the scale-sensitive one.";
+  r.prediction =
+      "E[i]: `formulas::expected_visits_exact` (= Eq. 9, 10, 13 as printed, which "
+      "`expected_visits_eq9_as_printed`, `eq10_traditional`, `eq13_scale_sensitive` evaluate "
+      "literally); `eq12_limit` (printed) vs `eq12_correct_limit`; tests per primary ray: "
+      "`expected_tests_sorted` / `expected_tests_traditional` (exact for this traversal) and "
+      "`expected_eq8_cost` (the paper's Eq. 8 model).";
+  r.table.columns = {"sweep",
+                     "n",
+                     "l1",
+                     "l_max",
+                     "p",
+                     "b",
+                     "rays",
+                     "mean_i",
+                     "se_i",
+                     "eq9_exact",
+                     "eq9_printed",
+                     "eq10_or_13_printed",
+                     "eq12_printed",
+                     "eq12_correct",
+                     "mean_tests",
+                     "se_tests",
+                     "tests_exact",
+                     "eq8_expected",
+                     "log2_p",
+                     "log2_b"};
+  const int n = 2;
+  const int rays = c.quick ? 1500 : 40000;
+
+  auto add_row = [&](int sweep, int l1, int lm, double p, const Mean& mi, const Mean& mt,
+                     double tests_exact) {
+    const double b = std::pow(n, l1);
+    const double e = formulas::expected_visits_exact(p, b);
+    const double eq1013 = sweep == 0 ? safe([&] { return formulas::eq10_traditional(n, p); })
+                                     : safe([&] { return formulas::eq13_scale_sensitive(p, b); });
+    r.table.add({double(sweep),
+                 double(n),
+                 double(l1),
+                 double(lm),
+                 p,
+                 b,
+                 double(mi.count),
+                 mi.mean(),
+                 mi.se(),
+                 e,
+                 safe([&] { return formulas::expected_visits_eq9_as_printed(p, b); }),
+                 eq1013,
+                 formulas::eq12_limit(n),
+                 formulas::eq12_correct_limit(n),
+                 mt.mean(),
+                 mt.se(),
+                 tests_exact,
+                 formulas::expected_eq8_cost(n, static_cast<std::uint64_t>(b), p),
+                 std::log2(p),
+                 double(l1)});
+    const std::string where = "sweep " + str(sweep) + " l1=" + str(l1) + " p=" + fmt(p);
+    // Tolerance: 4 standard errors, plus 5/rays of the prediction for outcomes too rare to
+    // be seen at all in `rays` draws (then the sample variance is 0).
+    const double rare = 5.0 / mi.count;
+    r.checks.push_back({where + ": mean visits on level l1 = E[i] (4 s.e.)", mi.mean(), e,
+                        4 * mi.se() + rare * e});
+    r.checks.push_back({where + ": mean primary tests = exact expectation (4 s.e.)", mt.mean(),
+                        tests_exact, 4 * mt.se() + rare * tests_exact});
+  };
+
+  // Sweep 0: traditional renderer, l1 = l_max - 1, p = n^l_max (p/b = n).
+  const int max_lmax = c.quick ? 10 : 20;
+  for (int lm = 2; lm <= max_lmax; ++lm) {
+    const double p = std::pow(n, lm);
+    const int l1 = lm - 1;
+    Mean mi, mt;
+    for (int k = 0; k < rays; ++k) {
+      const LoadedScene s =
+          scene("poisson", {{"n", str(n)}, {"depth", str(lm)}, {"p", str(p)}, {"seed", str(k)}});
+      const TraceOutput t = trace_centre(s, traditional());
+      const double b = std::pow(n, l1);
+      mi.add(t.hit.kind == TraceHit::Kind::kPrimitive ? double(t.hit.id / n + 1) : b);
+      mt.add(u(t.counters.tests_of(RayKind::kPrimary)));
+    }
+    add_row(0, l1, lm, p, mi, mt, formulas::expected_tests_traditional(n, lm, p));
+  }
+  // Sweep 1: scale-sensitive, b = n^4 fixed, p swept.
+  const int l1f = 4, depth1 = c.quick ? 16 : 30;
+  for (int k2 = -2; k2 <= (c.quick ? 12 : 24); k2 += c.quick ? 2 : 1) {
+    const double p = std::ldexp(1.0, k2);
+    const LoadedScene s = scene("poisson", {{"n", str(n)}, {"depth", str(depth1)}, {"p", str(p)}});
+    Mean mi, mt;
+    for (int k = 0; k < rays; ++k) {
+      RenderOptions o = at_level(l1f);
+      o.seed = static_cast<std::uint64_t>(k);
+      const TraceOutput t = trace_centre(s, o);
+      const double b = std::pow(n, l1f);
+      mi.add(t.hit.kind == TraceHit::Kind::kAmalgam ? double(TubeHierarchy::index_of(t.hit.id) + 1)
+                                                    : b);
+      mt.add(u(t.counters.tests_of(RayKind::kPrimary)));
+    }
+    add_row(1, l1f, depth1, p, mi, mt, formulas::expected_tests_sorted(n, l1f, p));
+  }
+  // Sweep 2: scale-sensitive, p fixed, l1 (so b = n^l1) swept.
+  const int depth2 = c.quick ? 12 : 18;
+  const double p2 = std::pow(n, depth2);
+  for (int l1 = 1; l1 < depth2 - 1; l1 += c.quick ? 2 : 1) {
+    const LoadedScene s = scene("poisson", {{"n", str(n)}, {"depth", str(depth2)}, {"p", str(p2)}});
+    Mean mi, mt;
+    for (int k = 0; k < rays; ++k) {
+      RenderOptions o = at_level(l1);
+      o.seed = static_cast<std::uint64_t>(k);
+      const TraceOutput t = trace_centre(s, o);
+      mi.add(t.hit.kind == TraceHit::Kind::kAmalgam ? double(TubeHierarchy::index_of(t.hit.id) + 1)
+                                                    : std::pow(n, l1));
+      mt.add(u(t.counters.tests_of(RayKind::kPrimary)));
+    }
+    add_row(2, l1, depth2, p2, mi, mt, formulas::expected_tests_sorted(n, l1, p2));
+  }
+
+  // Fits: traditional tests against log2 p; scale-sensitive against log2 b and against p.
+  auto fit_of = [&](int sweep, const std::string& xcol, bool log_y = false) {
+    std::vector<double> x, y;
+    for (const auto& row : r.table.rows)
+      if (row[0] == sweep && (sweep != 1 || row[4] >= 64)) {
+        x.push_back(row[r.table.col(xcol)]);
+        y.push_back(log_y ? std::log(row[14]) : row[14]);
+      }
+    return fit_line(x, y);
+  };
+  const LinearFit trad_log = fit_of(0, "log2_p");
+  const LinearFit ss_b = fit_of(2, "log2_b");
+  const LinearFit ss_p = fit_of(1, "log2_p");
+  r.checks.push_back({"traditional tests linear in log p (r^2)", trad_log.r2, 1.0, 0.01});
+  r.checks.push_back({"scale-sensitive tests linear in log b (r^2)", ss_b.r2, 1.0, 0.01});
+  r.checks.push_back(
+      {"scale-sensitive tests flat in p for p >> b (slope per doubling of p)", ss_p.b, 0.0, 0.25});
+  // Eq. 12: at the largest p, the measured mean vs the printed and the corrected limit.
+  std::size_t last_trad = 0;
+  for (std::size_t i = 0; i < r.table.rows.size(); ++i)
+    if (r.table.rows[i][0] == 0) last_trad = i;
+  const auto& lt = r.table.rows[last_trad];
+  const double z_printed = (lt[7] - lt[12]) / lt[8];
+  const double z_correct = (lt[7] - lt[13]) / lt[8];
+  r.checks.push_back({"traditional E[i] at largest p = corrected Eq. 12 limit 1/(1-e^-n)", lt[7],
+                      lt[13], 4 * lt[8]});
+  r.checks.push_back({"printed Eq. 12 (1-e^-n) is below the measurement by > 10 s.e.",
+                      std::min(z_printed, 10.0), 10.0, 0.0});
+
+  r.summary_columns = {
+      "sweep",        "l1",           "p",          "b",           "mean_i",      "eq9_exact",
+      "eq12_printed", "eq12_correct", "mean_tests", "tests_exact", "eq8_expected"};
+  for (std::size_t i = 0; i < r.table.rows.size(); ++i) {
+    const auto& row = r.table.rows[i];
+    const bool last_of_sweep = i + 1 == r.table.rows.size() || r.table.rows[i + 1][0] != row[0];
+    if (i == 0 || last_of_sweep || (i > 0 && r.table.rows[i - 1][0] != row[0]) ||
+        (row[0] == 0 && int(row[3]) % 4 == 0))
+      r.summary_rows.push_back(i);
+  }
+  r.panels.push_back({"Amalgams visited on level l1 (n=2)",
+                      "p (expected hits on the ray)",
+                      "mean number visited, E[i]",
+                      true,
+                      true,
+                      {{"p", "mean_i", "traditional (b = p/n), measured", false, "sweep", 0},
+                       {"p", "eq9_exact", "Eq. 9/10", true, "sweep", 0},
+                       {"p", "eq12_printed", "Eq. 12 as printed (1-e^{-n})", true, "sweep", 0},
+                       {"p", "eq12_correct", "Eq. 12 corrected 1/(1-e^{-n})", true, "sweep", 0},
+                       {"p", "mean_i", "scale-sensitive b=16, measured", false, "sweep", 1},
+                       {"p", "eq9_exact", "Eq. 9/13, b=16", true, "sweep", 1}}});
+  r.panels.push_back({"Tests per primary ray (n=2)",
+                      "p",
+                      "mean intersection tests per primary ray",
+                      true,
+                      false,
+                      {{"p", "mean_tests", "traditional, measured", false, "sweep", 0},
+                       {"p", "tests_exact", "traditional, exact expectation", true, "sweep", 0},
+                       {"p", "eq8_expected", "traditional, Eq. 8 model", true, "sweep", 0},
+                       {"p", "mean_tests", "scale-sensitive b=16, measured", false, "sweep", 1},
+                       {"p", "tests_exact", "scale-sensitive, exact expectation", true, "sweep", 1},
+                       {"p", "eq8_expected", "scale-sensitive, Eq. 8 model", true, "sweep", 1}}});
+  r.panels.push_back({"Scale-sensitive, p = 2^{" + str(depth2) + "} fixed, b = n^{l1} varied",
+                      "log_2 b = l1",
+                      "mean tests per primary ray",
+                      false,
+                      false,
+                      {{"log2_b", "mean_tests", "measured", false, "sweep", 2},
+                       {"log2_b", "tests_exact", "exact expectation", true, "sweep", 2},
+                       {"log2_b", "eq8_expected", "Eq. 8 model", true, "sweep", 2}}});
+  r.verdict = Verdict::kHoldsWithCorrection;
+  r.findings =
+      "Measured over " + str(rays) +
+      " rays per point (traditional: a new Poisson realisation per ray; scale-sensitive: a new "
+      "stochastic-opacity seed per ray).\n\n"
+      "* **Eq. 9, 10, 13 hold** (they are algebraically the truncated-geometric mean "
+      "(1 - e^{-p})/(1 - e^{-p/b})); every measured mean of visits on level l1 is within 4 "
+      "standard errors of it. The printed closed forms overflow/cancel numerically for large "
+      "p/b (nan in the CSV) but are exact where they can be evaluated.\n"
+      "* **Eq. 12 is wrong**: its left-hand side e^{-n}(e^n - 1)(e^{-n} - 1)^{-2} equals "
+      "1/(1 - e^{-n}), but the paper prints (1 - e^{-n}), the reciprocal. At the largest p "
+      "(p = " +
+      fmt(lt[4]) + ") the measured mean is " + fmt(lt[7]) + " +- " + fmt(lt[8]) +
+      "; the corrected limit 1/(1 - e^{-2}) = " + fmt(lt[13]) + " (z = " + fmt(z_correct) +
+      "), the printed 1 - e^{-2} = " + fmt(lt[12]) + " (z = " + fmt(z_printed) +
+      "). A mean number of visited amalgams below 1 is impossible. The conclusion O(1) "
+      "stands.\n"
+      "* **O(log p) vs O(log b)**: traditional tests per primary ray fit a + c log2 p with "
+      "c = " +
+      fmt(trad_log.b) + ", r^2 = " + fmt(trad_log.r2) +
+      " (O(log p)); scale-sensitive with b fixed is flat in p (slope " + fmt(ss_p.b) +
+      " tests per doubling of p for p >= 64) and, with p fixed, linear in log2 b (slope " +
+      fmt(ss_b.b) + ", r^2 = " + fmt(ss_b.r2) +
+      "). Measured tests match the exact expectation of this sorted traversal "
+      "(`expected_tests_sorted`) within statistical error. Eq. 8's max(log_n b + i, i C_b) "
+      "model undercounts by about a factor n because a sorted traversal tests all n children "
+      "of each entered node, a constant factor that leaves the asymptotics unchanged.";
+  return r;
+}
+
+}  // namespace amalgam::experiments

@@ -1,0 +1,99 @@
+#include "amalgam/analysis/experiments.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace amalgam::experiments {
+
+std::size_t Table::col(const std::string& name) const {
+  for (std::size_t i = 0; i < columns.size(); ++i)
+    if (columns[i] == name) return i;
+  throw std::out_of_range("experiment table: no column '" + name + "'");
+}
+
+bool Check::passed() const {
+  if (std::isnan(measured) || std::isnan(predicted)) return false;
+  return std::fabs(measured - predicted) <= tolerance;
+}
+
+const char* to_string(Verdict v) {
+  switch (v) {
+    case Verdict::kHolds:
+      return "holds";
+    case Verdict::kHoldsWithCorrection:
+      return "holds with correction";
+    case Verdict::kDoesNotHold:
+      return "does not hold";
+  }
+  return "?";
+}
+
+const std::vector<std::string>& names() {
+  static const std::vector<std::string> n = {"worst-traditional",
+                                             "worst-stochastic",
+                                             "worst-deterministic",
+                                             "expected",
+                                             "failed-tests",
+                                             "lights",
+                                             "noise",
+                                             "more-levels",
+                                             "linear-cost"};
+  return n;
+}
+
+ExperimentResult run(const std::string& name, const Config& config) {
+  using Fn = ExperimentResult (*)(const Config&);
+  static const std::vector<std::pair<std::string, Fn>> table = {
+      {"worst-traditional", worst_traditional},
+      {"worst-stochastic", worst_stochastic},
+      {"worst-deterministic", worst_deterministic},
+      {"expected", expected},
+      {"failed-tests", failed_tests},
+      {"lights", lights},
+      {"noise", noise},
+      {"more-levels", more_levels},
+      {"linear-cost", linear_cost}};
+  for (const auto& [n, f] : table) {
+    if (n != name) continue;
+    const auto t0 = std::chrono::steady_clock::now();
+    ExperimentResult r = f(config);
+    r.name = name;
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+  }
+  throw std::invalid_argument("unknown experiment '" + name + "'");
+}
+
+LinearFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {
+  const std::size_t n = std::min(x.size(), y.size());
+  LinearFit f;
+  if (n < 2) return f;
+  double sx = 0, sy = 0;
+  for (std::size_t i = 0; i < n; ++i) sx += x[i], sy += y[i];
+  const double mx = sx / n, my = sy / n;
+  double sxx = 0, sxy = 0, syy = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sxx += (x[i] - mx) * (x[i] - mx);
+    sxy += (x[i] - mx) * (y[i] - my);
+    syy += (y[i] - my) * (y[i] - my);
+  }
+  f.b = sxx > 0 ? sxy / sxx : 0;
+  f.a = my - f.b * mx;
+  f.r2 = (sxx > 0 && syy > 0) ? (sxy * sxy) / (sxx * syy) : 1.0;
+  return f;
+}
+
+std::string fmt(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[64];
+  if (v == std::floor(v) && std::fabs(v) < 1e15)
+    std::snprintf(buf, sizeof buf, "%.0f", v);
+  else
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+}  // namespace amalgam::experiments
