@@ -34,8 +34,15 @@ struct CommonOptions {
 /// Parses "x,y,z" into three floats; throws InputError naming the option.
 Vec3 parse_vec3(const std::string& text, const std::string& option);
 
-int run_render(CommonOptions& common, const std::string& out, const std::string& stats,
-               const std::string& cost_image);
+/// The options of `render` beyond the shared ones.
+struct RenderExtras {
+  std::string out, stats, cost_image, checkpoint;
+  bool resume = false;
+  bool quiet = false;
+  std::uint64_t max_memory = 0;  ///< bytes; 0: the machine's physical memory
+};
+
+int run_render(CommonOptions& common, const RenderExtras& extra);
 int run_trace(CommonOptions& common, const std::string& origin, const std::string& direction);
 int run_scenes();
 int run_experiment(const std::string& name, const std::string& out_dir, bool quick, int threads);

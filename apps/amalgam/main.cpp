@@ -14,12 +14,12 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   cli::CommonOptions render_opts;
-  std::string out, stats, cost_image;
+  cli::RenderExtras extras;
   CLI::App* render = app.add_subcommand("render", "render an image and report exact costs");
   render_opts.add_to(*render);
-  render->add_option("--out", out, "output image (.png, .exr or .pfm)")->required();
-  render->add_option("--stats", stats, "write the stats JSON to FILE, or - for stdout");
-  render->add_option("--cost-image", cost_image,
+  render->add_option("--out", extras.out, "output image (.png, .exr or .pfm)")->required();
+  render->add_option("--stats", extras.stats, "write the stats JSON to FILE, or - for stdout");
+  render->add_option("--cost-image", extras.cost_image,
                      "write intersection tests per pixel: false colour (.png) or raw (.exr/.pfm)");
   render->add_option("--width", render_opts.options.width, "image width (default 512)")
       ->check(CLI::PositiveNumber);
@@ -27,6 +27,15 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   render->add_option("--spp", render_opts.options.spp, "samples per pixel (default 4)")
       ->check(CLI::PositiveNumber);
+  render->add_option("--checkpoint", extras.checkpoint,
+                     "checkpoint file written when interrupted (default: OUT.ckpt)");
+  render->add_flag("--resume", extras.resume,
+                   "continue an interrupted render from its checkpoint (same options)");
+  render->add_flag("--quiet", extras.quiet, "no progress bar or summary on stderr");
+  render->add_option("--max-memory", extras.max_memory,
+                     "fail early if the render needs more bytes than this (suffixes K, M, G; "
+                     "default: physical memory)")
+      ->transform(CLI::AsSizeValue(false));
 
   cli::CommonOptions trace_opts;
   std::string origin, direction;
@@ -60,7 +69,7 @@ int main(int argc, char** argv) {
   }
 
   try {
-    if (render->parsed()) return cli::run_render(render_opts, out, stats, cost_image);
+    if (render->parsed()) return cli::run_render(render_opts, extras);
     if (trace->parsed()) return cli::run_trace(trace_opts, origin, direction);
     if (experiment->parsed()) return cli::run_experiment(exp_name, exp_out, exp_quick, exp_threads);
     return cli::run_scenes();

@@ -1,6 +1,16 @@
-#include <chrono>
-#include <iostream>
+#include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "amalgam/io/checkpoint.h"
 #include "amalgam/io/image.h"
 #include "amalgam/io/stats_json.h"
 #include "amalgam/render/render.h"
@@ -8,35 +18,176 @@
 
 namespace amalgam::cli {
 
-int run_render(CommonOptions& common, const std::string& out, const std::string& stats,
-               const std::string& cost_image) {
+namespace {
+
+std::atomic<bool> g_cancel{false};
+std::atomic<int> g_signal{0};
+
+extern "C" void on_signal(int sig) {
+  g_signal.store(sig);
+  g_cancel.store(true);
+}
+
+/// Everything that determines the image except spp and threads: a checkpoint is only
+/// resumed under the same fingerprint.
+std::string fingerprint(const CommonOptions& c) {
+  const RenderOptions& o = c.options;
+  std::ostringstream f;
+  f << c.scene;
+  std::vector<std::string> sets = c.sets;
+  std::sort(sets.begin(), sets.end());
+  for (const auto& s : sets) f << " --set " << s;
+  f << " --renderer " << c.renderer << " --opacity " << c.opacity << " --order " << c.order
+    << " --seed " << o.seed << " --width " << o.width << " --height " << o.height;
+  if (o.level)
+    f << " --level " << *o.level;
+  else
+    f << " --footprint " << o.footprint;
+  return f.str();
+}
+
+std::uint64_t physical_memory() {
+  return static_cast<std::uint64_t>(sysconf(_SC_PHYS_PAGES)) *
+         static_cast<std::uint64_t>(sysconf(_SC_PAGE_SIZE));
+}
+
+/// Bytes a render of these options needs beyond the scene: film buffers and per-thread state.
+std::uint64_t film_bytes(const RenderOptions& o) {
+  const std::uint64_t pixels = static_cast<std::uint64_t>(o.width) * o.height;
+  return pixels * (3 * sizeof(Vec3) + 3 * sizeof(std::uint64_t)) + (64u << 20);
+}
+
+std::uint64_t scene_bytes(const LoadedScene& s) {
+  if (const auto* e = std::get_if<ExplicitHierarchy>(&s.hierarchy))
+    return e->nodes.size() * (sizeof(ExplicitNode) + sizeof(Appearance)) +
+           e->prims.size() * sizeof(Primitive) + e->materials.size() * sizeof(Surface);
+  return 0;
+}
+
+std::string human_bytes(double b) {
+  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
+  int u = 0;
+  while (b >= 1024 && u < 4) b /= 1024, ++u;
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(u ? 1 : 0) << b << " " << units[u];
+  return s.str();
+}
+
+/// A one-line progress bar with ETA on stderr, shown only on a terminal, after one second.
+class Progress {
+ public:
+  Progress(int total, bool enabled) : total_(total), enabled_(enabled && isatty(2)) {}
+  void update(int done) {
+    if (!enabled_) return;
+    const double t = std::chrono::duration<double>(clock::now() - start_).count();
+    if (t < 1.0 || done <= 0) return;
+    const double eta = t / done * (total_ - done);
+    const int width = 30, fill = static_cast<int>(width * static_cast<double>(done) / total_);
+    std::fprintf(stderr, "\r[%s%s] %3d%% %d/%d spp, %.1f s, ETA %.1f s ",
+                 std::string(fill, '#').c_str(), std::string(width - fill, ' ').c_str(),
+                 100 * done / total_, done, total_, t, eta);
+    shown_ = true;
+  }
+  ~Progress() {
+    if (shown_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  using clock = std::chrono::steady_clock;
+  int total_;
+  bool enabled_;
+  bool shown_ = false;
+  clock::time_point start_ = clock::now();
+};
+
+void write_cost_image(const std::string& path, const RenderOutput& r) {
+  const std::string ext = path.substr(path.find_last_of('.') + 1);
+  if (ext == "png" || ext == "PNG") {
+    write_image(path, r.width, r.height, false_colour(r.cost, true));
+    return;
+  }
+  std::vector<Vec3> raw(r.cost.size());
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const auto v = static_cast<float>(r.cost[i]);
+    raw[i] = {v, v, v};
+  }
+  write_image(path, r.width, r.height, raw);
+}
+
+}  // namespace
+
+int run_render(CommonOptions& common, const RenderExtras& extra) {
   common.finish();
+  const RenderOptions& o = common.options;
+  const std::uint64_t limit = extra.max_memory ? extra.max_memory : physical_memory();
+  const std::uint64_t film = film_bytes(o);
+  if (film > limit)
+    throw InputError("--width " + std::to_string(o.width) + " --height " +
+                     std::to_string(o.height) + ": the film needs " + human_bytes(film) +
+                     ", more than --max-memory " + human_bytes(limit));
   const LoadedScene scene = load_scene(common.scene, common.params());
-  check_options(scene, common.options);
-  const RenderOutput r = render(scene, common.options);
-  write_image(out, r.width, r.height, r.image);
-  if (!cost_image.empty()) {
-    const std::string ext = cost_image.substr(cost_image.find_last_of('.') + 1);
-    if (ext == "png" || ext == "PNG") {
-      write_image(cost_image, r.width, r.height, false_colour(r.cost, true));
-    } else {
-      std::vector<Vec3> raw(r.cost.size());
-      for (std::size_t i = 0; i < raw.size(); ++i) {
-        const auto v = static_cast<float>(r.cost[i]);
-        raw[i] = {v, v, v};
-      }
-      write_image(cost_image, r.width, r.height, raw);
+  check_options(scene, o);
+  if (film + scene_bytes(scene) > limit)
+    throw InputError(common.scene + ": scene and film need " +
+                     human_bytes(film + scene_bytes(scene)) + ", more than --max-memory " +
+                     human_bytes(limit));
+
+  const std::string ckpt = extra.checkpoint.empty() ? extra.out + ".ckpt" : extra.checkpoint;
+  const std::string fp = fingerprint(common);
+  FilmState state;
+  if (extra.resume) {
+    if (!std::filesystem::exists(ckpt))
+      throw InputError(ckpt + ": no checkpoint to resume from");
+    state = read_checkpoint(ckpt, fp);
+    if (state.spp_done > o.spp)
+      throw InputError(ckpt + ": checkpoint holds " + std::to_string(state.spp_done) +
+                       " samples per pixel, more than --spp " + std::to_string(o.spp));
+  }
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  Progress progress(o.spp, !extra.quiet);
+  auto last_checkpoint = std::chrono::steady_clock::now();
+  RenderControl control;
+  control.cancel = &g_cancel;
+  control.on_pass = [&](const FilmState& st) {
+    progress.update(st.spp_done);
+    const auto now = std::chrono::steady_clock::now();
+    if (st.spp_done < o.spp && now - last_checkpoint > std::chrono::seconds(60)) {
+      write_checkpoint(ckpt, fp, st);  // survives even a SIGKILL
+      last_checkpoint = now;
     }
+  };
+  RenderOutput r = render(scene, o, &state, control);
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+
+  if (r.spp > 0) {
+    write_image(extra.out, r.width, r.height, r.image);
+    if (!extra.cost_image.empty()) write_cost_image(extra.cost_image, r);
   }
   const std::string json =
-      stats_json(scene, common.options, r.counters, r.per_primary, r.seconds).dump(2) + "\n";
-  if (stats == "-")
+      stats_json(scene, o, r.counters, r.per_primary, r.seconds).dump(2) + "\n";
+  if (extra.stats == "-")
     std::cout << json;
-  else if (!stats.empty())
-    write_text_atomic(stats, json);
-  std::cerr << "amalgam: wrote " << out << " (" << r.width << "x" << r.height << ", " << r.spp
-            << " spp, " << r.seconds << " s, " << r.per_primary.mean()
-            << " tests per primary ray)\n";
+  else if (!extra.stats.empty())
+    write_text_atomic(extra.stats, json);
+
+  if (r.interrupted) {
+    write_checkpoint(ckpt, fp, state);
+    const int sig = g_signal.load();
+    std::cerr << "amalgam: interrupted by " << (sig == SIGTERM ? "SIGTERM" : "SIGINT") << ": "
+              << (r.spp > 0 ? extra.out : std::string("no image")) << " holds " << r.spp
+              << " of " << o.spp << " samples per pixel; checkpoint " << ckpt
+              << " (continue with the same command and --resume)\n";
+    return 1;
+  }
+  std::error_code ec;
+  std::filesystem::remove(ckpt, ec);  // complete: the checkpoint is no longer needed
+  if (!extra.quiet)
+    std::cerr << "amalgam: wrote " << extra.out << " (" << r.width << "x" << r.height << ", "
+              << r.spp << " spp, " << r.seconds << " s, " << r.per_primary.mean()
+              << " tests per primary ray)\n";
   return 0;
 }
 

@@ -144,6 +144,8 @@ std::optional<SurfaceHit> intersect_sphere(const Ray& ray, Vec3 center, float ra
   const Vec3 f = ray.origin - center;
   const float a = dot(ray.dir, ray.dir);
   const float b = -dot(f, ray.dir);
+  // l: from the centre to the point of the line closest to it. Its length decides the hit
+  // far more accurately than the textbook discriminant when the origin is far away.
   const Vec3 l = f + ray.dir * (b / a);
   const float disc = radius * radius - dot(l, l);
   if (disc < 0.0f) return std::nullopt;
@@ -153,10 +155,15 @@ std::optional<SurfaceHit> intersect_sphere(const Ray& ray, Vec3 center, float ra
   float t1 = q / a;
   if (t0 > t1) std::swap(t0, t1);
   float t = t0;
-  if (t < ray.tmin) t = t1;
+  bool near = true;
+  if (t < ray.tmin) t = t1, near = false;
   if (!(t >= ray.tmin && t <= ray.tmax)) return std::nullopt;
-  // Reproject onto the sphere: the point's error is then relative to the sphere, not the ray.
-  const Vec3 outward = normalize(ray.at(t) - center);
+  // The hit relative to the centre, l -/+ (unit d) sqrt(disc): no cancellation against the
+  // ray origin; then reprojected onto the sphere.
+  const float inv_len = 1.0f / std::sqrt(a);
+  Vec3 v = l + ray.dir * (inv_len * (near ? -std::sqrt(disc) : std::sqrt(disc)));
+  const float vlen = length(v);
+  const Vec3 outward = vlen > 0.0f ? v / vlen : -ray.dir * inv_len;
   const Vec3 p = center + outward * radius;
   Vec3 n = outward;
   if (dot(n, ray.dir) > 0) n = -n;

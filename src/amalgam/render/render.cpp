@@ -57,57 +57,110 @@ void check_options(const LoadedScene& scene, const RenderOptions& o) {
     throw InputError("--width, --height and --spp must be at least 1");
 }
 
-RenderOutput render(const LoadedScene& scene, const RenderOptions& o) {
-  check_options(scene, o);
+RenderOutput finish(const FilmState& st) {
   RenderOutput out;
-  out.width = o.width;
-  out.height = o.height;
-  out.spp = o.spp;
-  out.image.assign(static_cast<std::size_t>(o.width) * o.height, Vec3{});
-  out.cost.assign(out.image.size(), 0.0);
-  const auto t0 = std::chrono::steady_clock::now();
+  out.width = st.width;
+  out.height = st.height;
+  out.spp = st.spp_done;
+  out.image.resize(st.sum.size());
+  out.cost.resize(st.sum.size());
+  const float inv = st.spp_done > 0 ? 1.0f / static_cast<float>(st.spp_done) : 0.0f;
+  for (std::size_t i = 0; i < st.sum.size(); ++i) {
+    out.image[i] = st.sum[i] * inv;
+    out.cost[i] = st.spp_done > 0 ? static_cast<double>(st.tests[i]) / st.spp_done : 0.0;
+  }
+  out.counters = st.counters;
+  out.per_primary = st.per_primary;
+  return out;
+}
 
+RenderOutput render(const LoadedScene& scene, const RenderOptions& o, FilmState* resume,
+                    const RenderControl& control) {
+  check_options(scene, o);
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t pixels = static_cast<std::size_t>(o.width) * o.height;
+  FilmState local;
+  FilmState& st = resume ? *resume : local;
+  if (st.sum.empty()) {
+    st = FilmState{};
+    st.width = o.width;
+    st.height = o.height;
+    st.sum.assign(pixels, Vec3{});
+    st.tests.assign(pixels, 0);
+  }
+  if (st.width != o.width || st.height != o.height || st.sum.size() != pixels ||
+      st.spp_done > o.spp)
+    throw InputError("resume: the saved render does not match these options");
+
+  // Samples per pass: whole samples for every pixel, about 2^16 primary rays per pass so that
+  // small images do not pay for many passes and large ones can stop quickly.
+  const int per_pass = std::max(1, static_cast<int>(65536 / std::max<std::size_t>(pixels, 1)));
+  bool interrupted = false;
   dispatch(scene, o, [&](const auto& h, auto lod, auto op, auto sorted) {
     using H = std::decay_t<decltype(h)>;
     using I = IntegratorFor<H, decltype(lod), decltype(op), decltype(sorted)>;
-    tbb::enumerable_thread_specific<ThreadState> states;
     const int threads = o.threads > 0 ? o.threads : tbb::this_task_arena::max_concurrency();
     tbb::task_arena arena(threads);
-    arena.execute([&] {
-      tbb::parallel_for(
-          tbb::blocked_range2d<int>(0, o.height, 8, 0, o.width, 8),
-          [&](const tbb::blocked_range2d<int>& r) {
-            ThreadState& st = states.local();
-            I integrator(h, scene.env, lod, st.counters);
-            for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
-              for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
-                const std::size_t pix = static_cast<std::size_t>(y) * o.width + x;
-                const std::uint64_t pixel_key = hash_combine(o.seed, pix);
-                Vec3 sum{};
-                std::uint64_t tests = 0;
-                for (int s = 0; s < o.spp; ++s) {
-                  const std::uint64_t key = hash_combine(pixel_key, static_cast<std::uint64_t>(s));
-                  Sampler jitter(hash_combine(key, 0x6a177e5));
-                  const float fx = static_cast<float>(x) + jitter.next();
-                  const float fy = static_cast<float>(y) + jitter.next();
-                  const Ray ray = scene.env.camera.generate(fx, fy, o.width, o.height);
-                  const std::uint64_t before = st.counters.total();
-                  sum += integrator.li(ray, key).colour;
-                  const std::uint64_t cost = st.counters.total() - before;
-                  st.per_primary.add(cost);
-                  tests += cost;
-                }
-                out.image[pix] = sum / static_cast<float>(o.spp);
-                out.cost[pix] = static_cast<double>(tests) / o.spp;
+    std::vector<Vec3> pass_sum;
+    std::vector<std::uint64_t> pass_tests;
+    while (st.spp_done < o.spp && !interrupted) {
+      const int s0 = st.spp_done, s1 = std::min(o.spp, s0 + per_pass);
+      pass_sum = st.sum;  // continue each pixel's running sum in sample order
+      pass_tests = st.tests;
+      tbb::enumerable_thread_specific<ThreadState> states;
+      std::atomic<bool> stopped{false};
+      arena.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range2d<int>(0, o.height, 8, 0, o.width, 8),
+            [&](const tbb::blocked_range2d<int>& r) {
+              if (control.cancel && control.cancel->load(std::memory_order_relaxed)) {
+                stopped.store(true, std::memory_order_relaxed);
+                return;
               }
-            }
-          });
-    });
-    for (const ThreadState& st : states) {
-      out.counters.merge(st.counters);
-      out.per_primary.merge(st.per_primary);
+              ThreadState& ts = states.local();
+              I integrator(h, scene.env, lod, ts.counters);
+              for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
+                for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+                  const std::size_t pix = static_cast<std::size_t>(y) * o.width + x;
+                  const std::uint64_t pixel_key = hash_combine(o.seed, pix);
+                  Vec3 sum = pass_sum[pix];
+                  std::uint64_t tests = 0;
+                  for (int s = s0; s < s1; ++s) {
+                    const std::uint64_t key =
+                        hash_combine(pixel_key, static_cast<std::uint64_t>(s));
+                    Sampler jitter(hash_combine(key, 0x6a177e5));
+                    const float fx = static_cast<float>(x) + jitter.next();
+                    const float fy = static_cast<float>(y) + jitter.next();
+                    const Ray ray = scene.env.camera.generate(fx, fy, o.width, o.height);
+                    const std::uint64_t before = ts.counters.total();
+                    sum += integrator.li(ray, key).colour;
+                    const std::uint64_t cost = ts.counters.total() - before;
+                    ts.per_primary.add(cost);
+                    tests += cost;
+                  }
+                  pass_sum[pix] = sum;
+                  pass_tests[pix] += tests;
+                }
+              }
+            });
+      });
+      if (stopped.load()) {  // the pass is incomplete: discard it
+        interrupted = true;
+        break;
+      }
+      st.sum.swap(pass_sum);
+      st.tests.swap(pass_tests);
+      for (const ThreadState& ts : states) {
+        st.counters.merge(ts.counters);
+        st.per_primary.merge(ts.per_primary);
+      }
+      st.spp_done = s1;
+      if (control.cancel && control.cancel->load() && st.spp_done < o.spp) interrupted = true;
+      if (control.on_pass) control.on_pass(st);
     }
   });
+  RenderOutput out = finish(st);
+  out.interrupted = interrupted;
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

@@ -13,12 +13,20 @@ class CostDistribution {
   static constexpr std::uint64_t kDense = 1u << 14;
 
   CostDistribution() : dense_(kDense, 0) {}
-  void add(std::uint64_t v) {
-    ++count_, sum_ += v;
+  void add(std::uint64_t v, std::uint64_t times = 1) {
+    count_ += times;
+    sum_ += static_cast<long double>(v) * static_cast<long double>(times);
     if (v < kDense)
-      ++dense_[v];
+      dense_[v] += times;
     else
-      ++sparse_[v];
+      sparse_[v] += times;
+  }
+  /// Calls f(value, times) for every value present, in increasing order.
+  template <class F>
+  void for_each(F&& f) const {
+    for (std::uint64_t v = 0; v < kDense; ++v)
+      if (dense_[v]) f(v, dense_[v]);
+    for (const auto& [v, c] : sparse_) f(v, c);
   }
   void merge(const CostDistribution& o);
   std::uint64_t count() const { return count_; }

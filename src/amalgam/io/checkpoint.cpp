@@ -1,0 +1,86 @@
+#include "amalgam/io/checkpoint.h"
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "amalgam/builtin/params.h"
+#include "amalgam/io/image.h"
+
+namespace amalgam {
+namespace {
+
+constexpr char kMagic[] = "AMALGAM-CHECKPOINT-1";
+
+template <class T>
+void put(std::ostream& out, const T& v) {
+  out.write(reinterpret_cast<const char*>(&v), sizeof v);
+}
+template <class T>
+void get(std::istream& in, T& v) {
+  in.read(reinterpret_cast<char*>(&v), sizeof v);
+}
+
+}  // namespace
+
+void write_checkpoint(const std::string& path, const std::string& fingerprint,
+                      const FilmState& st) {
+  std::ostringstream out(std::ios::binary);
+  out.write(kMagic, sizeof kMagic);
+  put(out, static_cast<std::uint64_t>(fingerprint.size()));
+  out.write(fingerprint.data(), static_cast<std::streamsize>(fingerprint.size()));
+  put(out, st.width);
+  put(out, st.height);
+  put(out, st.spp_done);
+  out.write(reinterpret_cast<const char*>(st.sum.data()),
+            static_cast<std::streamsize>(st.sum.size() * sizeof(Vec3)));
+  out.write(reinterpret_cast<const char*>(st.tests.data()),
+            static_cast<std::streamsize>(st.tests.size() * sizeof(std::uint64_t)));
+  put(out, st.counters);
+  std::uint64_t distinct = 0;
+  st.per_primary.for_each([&](std::uint64_t, std::uint64_t) { ++distinct; });
+  put(out, distinct);
+  st.per_primary.for_each([&](std::uint64_t v, std::uint64_t c) { put(out, v), put(out, c); });
+  write_text_atomic(path, out.str());
+}
+
+FilmState read_checkpoint(const std::string& path, const std::string& fingerprint) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open checkpoint: " + std::strerror(errno));
+  char magic[sizeof kMagic] = {};
+  in.read(magic, sizeof magic);
+  if (!in || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
+    throw InputError(path + ": not an amalgam checkpoint");
+  std::uint64_t len = 0;
+  get(in, len);
+  if (!in || len > (1u << 20)) throw InputError(path + ": corrupt checkpoint header");
+  std::string fp(len, '\0');
+  in.read(fp.data(), static_cast<std::streamsize>(len));
+  if (fp != fingerprint)
+    throw InputError(path + ": checkpoint was written for different settings (" + fp + ")");
+  FilmState st;
+  get(in, st.width);
+  get(in, st.height);
+  get(in, st.spp_done);
+  if (!in || st.width < 1 || st.height < 1 || st.spp_done < 0 ||
+      static_cast<std::uint64_t>(st.width) * st.height > (1ull << 32))
+    throw InputError(path + ": corrupt checkpoint header");
+  const std::size_t pixels = static_cast<std::size_t>(st.width) * st.height;
+  st.sum.resize(pixels);
+  st.tests.resize(pixels);
+  in.read(reinterpret_cast<char*>(st.sum.data()), static_cast<std::streamsize>(pixels * sizeof(Vec3)));
+  in.read(reinterpret_cast<char*>(st.tests.data()),
+          static_cast<std::streamsize>(pixels * sizeof(std::uint64_t)));
+  get(in, st.counters);
+  std::uint64_t distinct = 0;
+  get(in, distinct);
+  for (std::uint64_t i = 0; in && i < distinct; ++i) {
+    std::uint64_t v = 0, c = 0;
+    get(in, v), get(in, c);
+    st.per_primary.add(v, c);
+  }
+  if (!in) throw InputError(path + ": checkpoint is truncated");
+  return st;
+}
+
+}  // namespace amalgam

@@ -1,0 +1,20 @@
+#pragma once
+/// \file Checkpoints of progressive renders: the FilmState plus a fingerprint of everything
+/// that determines the image (scene, parameters, options other than spp and threads), so a
+/// render is only ever resumed with the settings it was started with.
+
+#include <string>
+
+#include "amalgam/render/render.h"
+
+namespace amalgam {
+
+/// Writes `state` atomically (temporary file + rename). Throws ImageIoError on failure.
+void write_checkpoint(const std::string& path, const std::string& fingerprint,
+                      const FilmState& state);
+
+/// Reads a checkpoint; throws InputError naming the file when it is unreadable, corrupt, or
+/// was written for a different fingerprint.
+FilmState read_checkpoint(const std::string& path, const std::string& fingerprint);
+
+}  // namespace amalgam
