@@ -1,0 +1,763 @@
+#include "amalgam/io/scene_file.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "amalgam/io/mesh_import.h"
+#include "amalgam/math/random.h"
+
+namespace amalgam {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string fmt(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Affine transforms (3x4, row-major).
+
+struct Affine {
+  double m[3][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}};
+
+  Vec3 apply(Vec3 p) const {
+    Vec3 r;
+    for (int i = 0; i < 3; ++i)
+      r[i] = static_cast<float>(m[i][0] * p.x + m[i][1] * p.y + m[i][2] * p.z + m[i][3]);
+    return r;
+  }
+  double det() const {
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  }
+  static Affine translate(Vec3 t) {
+    Affine a;
+    a.m[0][3] = t.x, a.m[1][3] = t.y, a.m[2][3] = t.z;
+    return a;
+  }
+  static Affine scale(Vec3 s) {
+    Affine a;
+    a.m[0][0] = s.x, a.m[1][1] = s.y, a.m[2][2] = s.z;
+    return a;
+  }
+  /// Rotation by `deg` degrees about axis 0 (x), 1 (y) or 2 (z), right-handed.
+  static Affine rotate(int axis, double deg) {
+    const double r = deg * std::numbers::pi / 180.0, c = std::cos(r), s = std::sin(r);
+    const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+    Affine a;
+    a.m[i][i] = c, a.m[i][j] = -s, a.m[j][i] = s, a.m[j][j] = c;
+    return a;
+  }
+};
+
+/// a * b: first b, then a.
+Affine operator*(const Affine& a, const Affine& b) {
+  Affine r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j) {
+      double v = j == 3 ? a.m[i][3] : 0.0;
+      for (int k = 0; k < 3; ++k) v += a.m[i][k] * b.m[k][j];
+      r.m[i][j] = v;
+    }
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Checked access to the JSON document: every error names the JSON pointer of the value.
+
+/// A value of the document with its JSON pointer.
+struct Val {
+  const json& j;
+  std::string ptr;
+};
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& ptr, const std::string& what) const {
+    throw InputError(file_ + ": " + (ptr.empty() ? std::string("top level") : ptr) + ": " + what);
+  }
+
+  static std::string escape(const std::string& key) {
+    std::string out;
+    for (char c : key) {
+      if (c == '~')
+        out += "~0";
+      else if (c == '/')
+        out += "~1";
+      else
+        out += c;
+    }
+    return out;
+  }
+
+  static Val child(const Val& v, const std::string& key) {
+    return {v.j.at(key), v.ptr + "/" + escape(key)};
+  }
+  static Val element(const Val& v, std::size_t i) {
+    return {v.j.at(i), v.ptr + "/" + std::to_string(i)};
+  }
+
+  /// Checks that `v` is an object whose keys are all in `allowed` ("comment" is always
+  /// allowed). Aliases ({"centre", "center"}) may not both be present.
+  void object(const Val& v, std::initializer_list<const char*> allowed) const {
+    if (!v.j.is_object()) fail(v.ptr, "expected an object, found " + type(v.j));
+    for (const auto& [key, value] : v.j.items()) {
+      if (key == "comment") continue;
+      bool ok = false;
+      for (const char* a : allowed) ok = ok || key == a;
+      if (!ok) {
+        std::string list;
+        for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+        fail(v.ptr + "/" + escape(key), "unknown key (expected one of: " + list + ")");
+      }
+    }
+  }
+
+  /// The child `key`, or `alias` (an alternative spelling); nullopt when neither is there.
+  std::optional<Val> find(const Val& v, const std::string& key,
+                          const std::string& alias = "") const {
+    const bool has_key = v.j.contains(key), has_alias = !alias.empty() && v.j.contains(alias);
+    if (has_key && has_alias)
+      fail(v.ptr, "both '" + key + "' and '" + alias + "' given (they mean the same)");
+    if (has_key) return child(v, key);
+    if (has_alias) return child(v, alias);
+    return std::nullopt;
+  }
+  Val require(const Val& v, const std::string& key, const std::string& alias = "") const {
+    if (auto c = find(v, key, alias)) return *c;
+    fail(v.ptr, "missing key '" + key + "'");
+  }
+
+  static std::string type(const json& j) {
+    if (j.is_number()) return "a number";
+    if (j.is_string()) return "a string";
+    if (j.is_boolean()) return "a boolean";
+    if (j.is_null()) return "null";
+    if (j.is_array()) return "an array";
+    return "an object";
+  }
+
+  double number(const Val& v, double lo = -1e30, double hi = 1e30,
+                const char* range = nullptr) const {
+    if (!v.j.is_number()) fail(v.ptr, "expected a number, found " + type(v.j));
+    const double x = v.j.get<double>();
+    if (!std::isfinite(x) || x < lo || x > hi)
+      fail(v.ptr, std::string("expected a number ") +
+                      (range ? range : "in [" + fmt(lo) + ", " + fmt(hi) + "]") + ", found " +
+                      fmt(x));
+    return x;
+  }
+  double positive(const Val& v) const { return number(v, 1e-30, 1e30, "> 0"); }
+  std::int64_t integer(const Val& v, std::int64_t lo, std::int64_t hi) const {
+    const std::string expected =
+        "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    if (!v.j.is_number_integer()) {
+      if (v.j.is_number_float()) {
+        const double x = v.j.get<double>();
+        if (x == std::floor(x) && x >= static_cast<double>(lo) && x <= static_cast<double>(hi))
+          return static_cast<std::int64_t>(x);
+      }
+      fail(v.ptr, expected + ", found " + (v.j.is_number() ? v.j.dump() : type(v.j)));
+    }
+    const bool neg = v.j.is_number_unsigned() ? false : v.j.get<std::int64_t>() < 0;
+    if (!neg && v.j.is_number_unsigned() &&
+        v.j.get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX))
+      fail(v.ptr, expected + ", found " + v.j.dump());
+    const std::int64_t x = v.j.get<std::int64_t>();
+    if (x < lo || x > hi) fail(v.ptr, expected + ", found " + v.j.dump());
+    return x;
+  }
+  bool boolean(const Val& v) const {
+    if (!v.j.is_boolean()) fail(v.ptr, "expected true or false, found " + type(v.j));
+    return v.j.get<bool>();
+  }
+  std::string string(const Val& v) const {
+    if (!v.j.is_string()) fail(v.ptr, "expected a string, found " + type(v.j));
+    return v.j.get<std::string>();
+  }
+  void array(const Val& v) const {
+    if (!v.j.is_array()) fail(v.ptr, "expected an array, found " + type(v.j));
+  }
+  Vec3 vec3(const Val& v) const {
+    if (!v.j.is_array() || v.j.size() != 3)
+      fail(v.ptr, "expected an array of 3 numbers, found " +
+                      (v.j.is_array() ? "an array of " + std::to_string(v.j.size()) : type(v.j)));
+    Vec3 r;
+    for (int i = 0; i < 3; ++i) {
+      const Val e = element(v, static_cast<std::size_t>(i));
+      if (!e.j.is_number()) fail(v.ptr, "expected an array of 3 numbers, found " + v.j.dump());
+      r[i] = static_cast<float>(number(e));
+    }
+    return r;
+  }
+  Vec3 colour(const Val& v) const {
+    const Vec3 c = vec3(v);
+    if (c.x < 0 || c.y < 0 || c.z < 0) fail(v.ptr, "expected non-negative colour components");
+    return c;
+  }
+  Vec3 direction(const Val& v) const {
+    const Vec3 d = vec3(v);
+    if (!(length(d) > 0.0f)) fail(v.ptr, "expected a non-zero direction");
+    return d;
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// The scene file proper.
+
+struct MeshEntry {
+  std::string name;
+  std::shared_ptr<const ImportedMesh> mesh;
+  Affine model;                           ///< fit, then the mesh's transform
+  std::optional<std::uint32_t> material;  ///< override
+  std::string ptr;
+};
+
+class SceneParser {
+ public:
+  SceneParser(const std::string& path, const SceneFileConfig& config)
+      : r_(path), dir_(fs::path(path).parent_path()), config_(config) {}
+
+  SceneDescription parse(const json& doc) {
+    const Val root{doc, ""};
+    r_.object(root, {"camera", "lights", "background", "materials", "meshes", "spheres", "boxes",
+                     "triangles", "instances"});
+    out_.materials.push_back(Surface{});  // 0: the default material
+    if (auto m = r_.find(root, "materials")) read_materials(*m);
+    if (auto b = r_.find(root, "background")) out_.env.background = r_.colour(*b);
+
+    // First count, then expand: an oversized scene fails before anything is allocated.
+    std::vector<Val> spheres, boxes, triangles;
+    if (auto v = r_.find(root, "spheres")) spheres = items(*v);
+    if (auto v = r_.find(root, "boxes")) boxes = items(*v);
+    if (auto v = r_.find(root, "triangles")) triangles = items(*v);
+    if (auto v = r_.find(root, "meshes")) read_meshes(*v);
+    std::vector<Placement> placements;
+    if (auto v = r_.find(root, "instances")) placements = read_instances(*v);
+    std::uint64_t total = spheres.size() + boxes.size() + triangles.size();
+    for (const MeshEntry& m : meshes_)
+      if (placed_.count(m.name)) add_count(total, m.mesh->triangles.size(), m.ptr);
+    for (const Placement& p : placements)
+      add_count(total, static_cast<double>(p.mesh->mesh->triangles.size()) * p.where.size(), p.ptr);
+    out_.prims.reserve(total);
+
+    for (const Val& s : spheres) read_sphere(s);
+    for (const Val& b : boxes) read_box(b);
+    for (const Val& t : triangles) read_triangle(t);
+    for (const MeshEntry& m : meshes_)
+      if (placed_.count(m.name)) place(m, Affine{}, m.material);
+    for (const Placement& p : placements)
+      for (const Affine& a : p.where) place(*p.mesh, a, p.material ? p.material : p.mesh->material);
+    if (out_.prims.empty())
+      r_.fail("",
+              "the scene has no geometry (give meshes, spheres, boxes, triangles or "
+              "instances)");
+
+    Bbox bounds;
+    for (const Primitive& p : out_.prims) bounds.extend(amalgam::bounds(p));
+    if (auto c = r_.find(root, "camera"))
+      out_.env.camera = read_camera(*c);
+    else
+      out_.env.camera = frame_camera(bounds);
+    if (auto l = r_.find(root, "lights"))
+      read_lights(*l);
+    else
+      out_.env.lights = default_lights(bounds, out_.env.camera);
+    return std::move(out_);
+  }
+
+ private:
+  struct Placement {
+    const MeshEntry* mesh;
+    std::vector<Affine> where;
+    std::optional<std::uint32_t> material;
+    std::string ptr;
+  };
+
+  std::vector<Val> items(const Val& v) const {
+    r_.array(v);
+    std::vector<Val> out;
+    for (std::size_t i = 0; i < v.j.size(); ++i) out.push_back(Reader::element(v, i));
+    return out;
+  }
+
+  void add_count(std::uint64_t& total, double more, const std::string& ptr) const {
+    if (static_cast<double>(total) + more > static_cast<double>(config_.max_triangles))
+      r_.fail(ptr, "the scene would hold " + fmt(static_cast<double>(total) + more) +
+                       " primitives, more than the limit of " +
+                       fmt(static_cast<double>(config_.max_triangles)) +
+                       " (instances are expanded into triangles until the two-level instance "
+                       "hierarchy exists)");
+    total += static_cast<std::uint64_t>(more);
+  }
+
+  // -- materials ------------------------------------------------------------------------------
+
+  Surface read_surface(const Val& v) const {
+    r_.object(v, {"colour", "color", "reflectance", "shininess"});
+    Surface s;
+    if (auto c = r_.find(v, "colour", "color")) s.colour = r_.colour(*c);
+    if (auto c = r_.find(v, "reflectance")) s.reflectance = static_cast<float>(r_.number(*c, 0, 1));
+    if (auto c = r_.find(v, "shininess"))
+      s.shininess = static_cast<float>(r_.number(*c, 1e-3, 1e6));
+    return s;
+  }
+
+  void read_materials(const Val& v) {
+    if (!v.j.is_object()) r_.fail(v.ptr, "expected an object mapping names to materials");
+    for (const auto& [name, value] : v.j.items()) {
+      material_index_[name] = static_cast<std::uint32_t>(out_.materials.size());
+      out_.materials.push_back(read_surface(Reader::child(v, name)));
+    }
+  }
+
+  /// A "material" value: the name of a material, or a material object.
+  std::uint32_t material_ref(const Val& v) {
+    if (v.j.is_string()) {
+      const std::string name = v.j.get<std::string>();
+      auto it = material_index_.find(name);
+      if (it == material_index_.end()) {
+        std::string list;
+        for (const auto& [n, i] : material_index_) list += (list.empty() ? "" : ", ") + n;
+        r_.fail(v.ptr, "unknown material '" + name + "' (" +
+                           (list.empty() ? "no materials are defined" : "defined: " + list) + ")");
+      }
+      return it->second;
+    }
+    if (!v.j.is_object())
+      r_.fail(v.ptr, "expected a material name or a material object, found " + Reader::type(v.j));
+    out_.materials.push_back(read_surface(v));
+    return static_cast<std::uint32_t>(out_.materials.size() - 1);
+  }
+  std::uint32_t optional_material(const Val& v) {
+    if (auto m = r_.find(v, "material")) return material_ref(*m);
+    return 0;
+  }
+
+  // -- camera and lights ----------------------------------------------------------------------
+
+  Camera read_camera(const Val& v) const {
+    r_.object(v, {"position", "look_at", "up", "vfov"});
+    Camera c;
+    c.position = r_.vec3(r_.require(v, "position"));
+    c.look_at = r_.vec3(r_.require(v, "look_at"));
+    if (auto u = r_.find(v, "up")) c.up = r_.direction(*u);
+    if (auto f = r_.find(v, "vfov"))
+      c.vfov_deg = static_cast<float>(r_.number(*f, 0.01, 179.0, "in (0, 180) degrees"));
+    const Vec3 d = c.look_at - c.position;
+    if (!(length(d) > 0.0f)) r_.fail(v.ptr + "/look_at", "must differ from the position");
+    if (!(length(cross(normalize(d), normalize(c.up))) > 1e-6f))
+      r_.fail(v.ptr + "/up", "must not be parallel to the viewing direction");
+    return c;
+  }
+
+  void read_lights(const Val& v) {
+    for (const Val& l : items(v)) {
+      const std::string type = r_.string(r_.require(l, "type"));
+      Light light;
+      if (type == "point") {
+        r_.object(l, {"type", "position", "intensity"});
+        light.kind = LightKind::kPoint;
+        light.position = r_.vec3(r_.require(l, "position"));
+      } else if (type == "directional") {
+        r_.object(l, {"type", "direction", "intensity"});
+        light.kind = LightKind::kDirectional;
+        light.direction = normalize(r_.direction(r_.require(l, "direction")));
+      } else {
+        r_.fail(l.ptr + "/type", "expected \"point\" or \"directional\", found \"" + type + "\"");
+      }
+      light.intensity = r_.colour(r_.require(l, "intensity"));
+      out_.env.lights.push_back(light);
+    }
+  }
+
+  // -- primitives -----------------------------------------------------------------------------
+
+  void read_sphere(const Val& v) {
+    r_.object(v, {"centre", "center", "radius", "material"});
+    const Vec3 c = r_.vec3(r_.require(v, "centre", "center"));
+    const auto radius = static_cast<float>(r_.positive(r_.require(v, "radius")));
+    out_.prims.push_back(Primitive::sphere(c, radius, optional_material(v)));
+  }
+
+  void read_box(const Val& v) {
+    r_.object(v, {"min", "max", "material"});
+    const Vec3 lo = r_.vec3(r_.require(v, "min")), hi = r_.vec3(r_.require(v, "max"));
+    if (lo.x > hi.x || lo.y > hi.y || lo.z > hi.z)
+      r_.fail(v.ptr + "/max", "expected max >= min in every coordinate");
+    out_.prims.push_back(Primitive::box(lo, hi, optional_material(v)));
+  }
+
+  void read_triangle(const Val& v) {
+    r_.object(v, {"vertices", "material"});
+    const Val vs = r_.require(v, "vertices");
+    if (!vs.j.is_array() || vs.j.size() != 3)
+      r_.fail(vs.ptr, "expected an array of 3 vertices (each an array of 3 numbers)");
+    Vec3 p[3];
+    for (std::size_t i = 0; i < 3; ++i) p[i] = r_.vec3(Reader::element(vs, i));
+    if (!(length(cross(p[1] - p[0], p[2] - p[0])) > 0.0f))
+      r_.fail(vs.ptr, "the triangle has zero area");
+    out_.prims.push_back(Primitive::triangle(p[0], p[1], p[2], optional_material(v)));
+  }
+
+  // -- transforms -----------------------------------------------------------------------------
+
+  Affine read_transform(const Val& v) const {
+    r_.object(v, {"matrix", "translate", "scale", "rotate_x_deg", "rotate_y_deg", "rotate_z_deg"});
+    Affine a;
+    if (auto m = r_.find(v, "matrix")) {
+      if (v.j.size() != (v.j.contains("comment") ? 2u : 1u))
+        r_.fail(v.ptr, "'matrix' cannot be combined with translate, scale or rotate");
+      a = read_matrix(*m);
+    } else {
+      if (auto s = r_.find(v, "scale")) {
+        Vec3 k;
+        if (s->j.is_number()) {
+          const auto f = static_cast<float>(r_.number(*s));
+          k = {f, f, f};
+        } else {
+          k = r_.vec3(*s);
+        }
+        if (k.x == 0 || k.y == 0 || k.z == 0) r_.fail(s->ptr, "scale factors must not be zero");
+        a = Affine::scale(k);
+      }
+      const char* rot[] = {"rotate_x_deg", "rotate_y_deg", "rotate_z_deg"};
+      for (int axis = 0; axis < 3; ++axis)
+        if (auto r = r_.find(v, rot[axis])) a = Affine::rotate(axis, r_.number(*r)) * a;
+      if (auto t = r_.find(v, "translate")) a = Affine::translate(r_.vec3(*t)) * a;
+    }
+    return a;
+  }
+
+  Affine read_matrix(const Val& v) const {
+    const char* expected = "expected a 4x4 matrix: 4 rows of 4 numbers, or 16 numbers, row-major";
+    std::vector<double> m;
+    if (!v.j.is_array()) r_.fail(v.ptr, expected);
+    if (v.j.size() == 16) {
+      for (std::size_t i = 0; i < 16; ++i) m.push_back(r_.number(Reader::element(v, i)));
+    } else if (v.j.size() == 4) {
+      for (std::size_t i = 0; i < 4; ++i) {
+        const Val row = Reader::element(v, i);
+        if (!row.j.is_array() || row.j.size() != 4) r_.fail(row.ptr, "expected a row of 4 numbers");
+        for (std::size_t k = 0; k < 4; ++k) m.push_back(r_.number(Reader::element(row, k)));
+      }
+    } else {
+      r_.fail(v.ptr, expected);
+    }
+    if (m[12] != 0 || m[13] != 0 || m[14] != 0 || m[15] != 1)
+      r_.fail(v.ptr, "expected an affine matrix (last row 0 0 0 1)");
+    Affine a;
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 4; ++k) a.m[i][k] = m[static_cast<std::size_t>(i * 4 + k)];
+    if (!(std::fabs(a.det()) > 0)) r_.fail(v.ptr, "the matrix is singular");
+    return a;
+  }
+
+  // -- meshes and instances -------------------------------------------------------------------
+
+  void read_meshes(const Val& v) {
+    for (const Val& m : items(v)) {
+      r_.object(m, {"file", "name", "transform", "material", "fit", "place"});
+      const Val file = r_.require(m, "file");
+      const fs::path rel = r_.string(file);
+      const fs::path full = rel.is_absolute() || dir_.empty() ? rel : dir_ / rel;
+      MeshEntry e;
+      e.ptr = m.ptr;
+      e.name = m.j.contains("name") ? r_.string(Reader::child(m, "name")) : m.ptr;
+      for (const MeshEntry& other : meshes_)
+        if (other.name == e.name)
+          r_.fail(m.ptr + "/name", "a mesh named '" + e.name + "' already exists");
+      auto cached = imported_.find(full.string());
+      if (cached == imported_.end()) {
+        try {
+          ImportConfig ic;
+          ic.max_triangles = config_.max_triangles;
+          cached =
+              imported_
+                  .emplace(full.string(),
+                           std::make_shared<const ImportedMesh>(import_mesh(full.string(), ic)))
+                  .first;
+        } catch (const InputError& err) {
+          r_.fail(file.ptr, err.what());
+        }
+      }
+      e.mesh = cached->second;
+      if (auto f = r_.find(m, "fit")) {
+        // Uniform scale to the given largest extent, centred in x and z, resting on y = 0.
+        const Bbox b = e.mesh->bounds;
+        const double s = r_.positive(*f) / std::max(max_component(b.extent()), 1e-30f);
+        e.model =
+            Affine::scale({static_cast<float>(s), static_cast<float>(s), static_cast<float>(s)}) *
+            Affine::translate({-b.center().x, -b.lo.y, -b.center().z});
+      }
+      if (auto t = r_.find(m, "transform")) e.model = read_transform(*t) * e.model;
+      if (auto mat = r_.find(m, "material")) e.material = material_ref(*mat);
+      const bool show = m.j.contains("place") ? r_.boolean(Reader::child(m, "place")) : true;
+      meshes_.push_back(std::move(e));
+      if (show) placed_.insert(meshes_.back().name);
+    }
+    for (const MeshEntry& e : meshes_) by_name_[e.name] = &e;
+  }
+
+  std::vector<Placement> read_instances(const Val& v) {
+    std::vector<Placement> out;
+    for (const Val& in : items(v)) {
+      r_.object(in, {"mesh", "transform", "material", "transforms", "grid", "scatter"});
+      const Val name = r_.require(in, "mesh");
+      const std::string n = r_.string(name);
+      auto it = by_name_.find(n);
+      if (it == by_name_.end()) {
+        std::string list;
+        for (const auto& [k, e] : by_name_) list += (list.empty() ? "" : ", ") + k;
+        r_.fail(name.ptr,
+                "no mesh named '" + n + "' (" +
+                    (list.empty() ? std::string("no meshes are defined") : "meshes: " + list) +
+                    ")");
+      }
+      Placement p{it->second, {}, std::nullopt, in.ptr};
+      const Affine local =
+          in.j.contains("transform") ? read_transform(Reader::child(in, "transform")) : Affine{};
+      if (auto mat = r_.find(in, "material")) p.material = material_ref(*mat);
+      const int kinds =
+          in.j.contains("transforms") + in.j.contains("grid") + in.j.contains("scatter");
+      if (kinds != 1) r_.fail(in.ptr, "expected exactly one of 'transforms', 'grid' or 'scatter'");
+      std::vector<Affine> where;
+      if (auto t = r_.find(in, "transforms")) {
+        for (const Val& e : items(*t)) where.push_back(read_transform(e));
+      } else if (auto g = r_.find(in, "grid")) {
+        where = read_grid(*g, it->second->mesh->triangles.size());
+      } else {
+        where = read_scatter(r_.require(in, "scatter"), it->second->mesh->triangles.size());
+      }
+      for (Affine& a : where) a = a * local;
+      p.where = std::move(where);
+      out.push_back(std::move(p));
+    }
+    return out;
+  }
+
+  static constexpr std::int64_t kMaxInstances = 100'000'000;
+
+  std::vector<Affine> read_grid(const Val& v, std::size_t triangles) const {
+    r_.object(v, {"nx", "nz", "spacing", "origin"});
+    const std::int64_t nx = r_.integer(r_.require(v, "nx"), 1, 1'000'000);
+    const std::int64_t nz = r_.integer(r_.require(v, "nz"), 1, 1'000'000);
+    const double spacing = r_.positive(r_.require(v, "spacing"));
+    const Vec3 origin = v.j.contains("origin") ? r_.vec3(Reader::child(v, "origin")) : Vec3{};
+    if (nx * nz > kMaxInstances)
+      r_.fail(v.ptr, "nx * nz = " + std::to_string(nx * nz) + " instances, more than " +
+                         std::to_string(kMaxInstances));
+    add_instances_check(static_cast<double>(nx * nz), triangles, v.ptr);
+    std::vector<Affine> out;
+    out.reserve(static_cast<std::size_t>(nx * nz));
+    for (std::int64_t j = 0; j < nz; ++j)
+      for (std::int64_t i = 0; i < nx; ++i)
+        out.push_back(Affine::translate(
+            {origin.x + static_cast<float>((static_cast<double>(i) - 0.5 * (nx - 1)) * spacing),
+             origin.y,
+             origin.z + static_cast<float>((static_cast<double>(j) - 0.5 * (nz - 1)) * spacing)}));
+    return out;
+  }
+
+  std::vector<Affine> read_scatter(const Val& v, std::size_t triangles) const {
+    r_.object(v, {"count", "radius", "seed", "centre", "center", "rotate"});
+    const std::int64_t count = r_.integer(r_.require(v, "count"), 1, kMaxInstances);
+    const double radius = r_.positive(r_.require(v, "radius"));
+    const auto seed = static_cast<std::uint64_t>(
+        v.j.contains("seed") ? r_.integer(Reader::child(v, "seed"), 0, INT64_MAX) : 0);
+    const Vec3 centre = [&] {
+      auto c = r_.find(v, "centre", "center");
+      return c ? r_.vec3(*c) : Vec3{};
+    }();
+    const bool rotate = v.j.contains("rotate") ? r_.boolean(Reader::child(v, "rotate")) : true;
+    add_instances_check(static_cast<double>(count), triangles, v.ptr);
+    std::vector<Affine> out;
+    out.reserve(static_cast<std::size_t>(count));
+    for (std::int64_t i = 0; i < count; ++i) {
+      // Uniform on the disc of `radius` in the plane y = centre.y.
+      Sampler s(hash_combine(seed, static_cast<std::uint64_t>(i)));
+      const double r = radius * std::sqrt(static_cast<double>(s.next()));
+      const double phi = 2.0 * std::numbers::pi * s.next();
+      const double angle = rotate ? 360.0 * s.next() : 0.0;
+      out.push_back(Affine::translate({centre.x + static_cast<float>(r * std::cos(phi)), centre.y,
+                                       centre.z + static_cast<float>(r * std::sin(phi))}) *
+                    Affine::rotate(1, angle));
+    }
+    return out;
+  }
+
+  /// Fails before the generator allocates its transforms when its instances alone would hold
+  /// too many triangles (the scene-wide count is checked again once all are read).
+  void add_instances_check(double count, std::size_t triangles, const std::string& ptr) const {
+    const double total = count * static_cast<double>(triangles);
+    if (total > static_cast<double>(config_.max_triangles))
+      r_.fail(ptr, fmt(count) + " instances of " + fmt(static_cast<double>(triangles)) +
+                       " triangles would hold " + fmt(total) +
+                       " triangles, more than the limit of " +
+                       fmt(static_cast<double>(config_.max_triangles)) +
+                       " (instances are expanded into triangles until the two-level instance "
+                       "hierarchy exists)");
+  }
+
+  void place(const MeshEntry& m, const Affine& where, std::optional<std::uint32_t> material) {
+    const Affine a = where * m.model;
+    const auto base = static_cast<std::uint32_t>(out_.materials.size());
+    const bool own = !material.has_value();
+    if (own) {
+      // The mesh's own materials, appended once per mesh entry.
+      auto it = material_base_.find(&m);
+      if (it == material_base_.end()) {
+        out_.materials.insert(out_.materials.end(), m.mesh->materials.begin(),
+                              m.mesh->materials.end());
+        it = material_base_.emplace(&m, base).first;
+      }
+      for (const Primitive& t : m.mesh->triangles)
+        out_.prims.push_back(
+            Primitive::triangle(a.apply(t.a), a.apply(t.b), a.apply(t.c), it->second + t.material));
+    } else {
+      for (const Primitive& t : m.mesh->triangles)
+        out_.prims.push_back(
+            Primitive::triangle(a.apply(t.a), a.apply(t.b), a.apply(t.c), *material));
+    }
+  }
+
+  Reader r_;
+  fs::path dir_;
+  SceneFileConfig config_;
+  SceneDescription out_;
+  std::map<std::string, std::uint32_t> material_index_;
+  std::map<std::string, std::shared_ptr<const ImportedMesh>> imported_;
+  std::vector<MeshEntry> meshes_;
+  std::set<std::string> placed_;
+  std::map<std::string, const MeshEntry*> by_name_;
+  std::map<const MeshEntry*, std::uint32_t> material_base_;
+};
+
+/// Turns nlohmann's parse error into "line L, column C: what".
+std::string describe_parse_error(const json::parse_error& e, const std::string& text) {
+  const std::size_t byte = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
+  std::size_t line = 1, column = 1;
+  for (std::size_t i = 0; i < byte; ++i) {
+    if (text[i] == '\n')
+      ++line, column = 1;
+    else
+      ++column;
+  }
+  std::string what = e.what();
+  // "[json.exception.parse_error.101] parse error at line 1, column 2: syntax error ..."
+  const auto col = what.find("column ");
+  const auto colon = what.find(": ", col == std::string::npos ? 0 : col);
+  if (colon != std::string::npos) what = what.substr(colon + 2);
+  for (char& c : what)
+    if (c == '\n' || c == '\r') c = ' ';
+  return "line " + std::to_string(line) + ", column " + std::to_string(column) +
+         ": invalid JSON: " + what;
+}
+
+}  // namespace
+
+SceneDescription parse_scene_json(const std::string& text, const std::string& path,
+                                  const SceneFileConfig& config) {
+  json doc;
+  try {
+    doc = json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+  } catch (const json::parse_error& e) {
+    throw InputError(path + ": " + describe_parse_error(e, text));
+  }
+  return SceneParser(path, config).parse(doc);
+}
+
+SceneDescription read_scene_json(const std::string& path, const SceneFileConfig& config) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw InputError(path + ": no such file");
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  if (!in || !(text << in.rdbuf())) throw InputError(path + ": cannot read the file");
+  return parse_scene_json(text.str(), path, config);
+}
+
+Camera frame_camera(const Bbox& bounds, float vfov_deg) {
+  Camera c;
+  c.vfov_deg = vfov_deg;
+  const Vec3 centre = bounds.center();
+  const float radius = std::max(0.5f * bounds.diagonal(), 1e-6f);
+  // Azimuth 35 degrees right of +z, elevation 25 degrees.
+  const float az = 35.0f * std::numbers::pi_v<float> / 180.0f;
+  const float el = 25.0f * std::numbers::pi_v<float> / 180.0f;
+  const Vec3 dir{std::sin(az) * std::cos(el), std::sin(el), std::cos(az) * std::cos(el)};
+  const float half = 0.5f * vfov_deg * std::numbers::pi_v<float> / 180.0f;
+  c.position = centre + dir * (radius / std::sin(half));
+  c.look_at = centre;
+  c.up = {0, 1, 0};
+  return c;
+}
+
+std::vector<Light> default_lights(const Bbox& bounds, const Camera& camera) {
+  Light key;
+  key.kind = LightKind::kDirectional;
+  key.direction = normalize(Vec3{0.45f, -1.0f, -0.6f});
+  key.intensity = {2.2f, 2.1f, 2.0f};
+  Light fill;
+  fill.kind = LightKind::kPoint;
+  fill.position = camera.position;
+  const float d = length(camera.position - bounds.center());
+  const float e = 0.9f * d * d;  // irradiance 0.9 at the centre of the bounds
+  fill.intensity = {e, e, e};
+  return {key, fill};
+}
+
+SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& config) {
+  ImportConfig ic;
+  ic.max_triangles = config.max_triangles;
+  ImportedMesh m = import_mesh(path, ic);
+  SceneDescription d;
+  d.prims = std::move(m.triangles);
+  d.materials = std::move(m.materials);
+  d.env.camera = frame_camera(m.bounds);
+  d.env.lights = default_lights(m.bounds, d.env.camera);
+  return d;
+}
+
+LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config) {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  SceneDescription d = lower(fs::path(path).extension().string()) == ".json"
+                           ? read_scene_json(path, config)
+                           : mesh_scene(path, config);
+  const auto t1 = Clock::now();
+  ExplicitHierarchy h = build_explicit(std::move(d.prims), std::move(d.materials));
+  const auto t2 = Clock::now();
+  LoadedScene s{path, std::move(h), std::move(d.env)};
+  s.load_seconds = std::chrono::duration<double>(t1 - t0).count();
+  s.build_seconds = std::chrono::duration<double>(t2 - t1).count();
+  return s;
+}
+
+}  // namespace amalgam

@@ -1,0 +1,51 @@
+#pragma once
+/// \file Scene paths: scene files (`.json`, schema in the README) and bare meshes, which get a
+/// default camera and lights.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "amalgam/scene/load.h"
+
+namespace amalgam {
+
+/// Settings for reading scene paths.
+struct SceneFileConfig {
+  /// Instances are expanded into triangles (a two-level instance hierarchy is not built yet):
+  /// a scene that would hold more primitives than this is an InputError.
+  std::uint64_t max_triangles = 50'000'000;
+};
+
+/// A scene as described, before any hierarchy is built.
+struct SceneDescription {
+  std::vector<Primitive> prims;
+  std::vector<Surface> materials;  ///< indexed by Primitive::material; never empty
+  Environment env;
+};
+
+/// Reads a scene file. Relative mesh paths resolve against the file's folder. Throws
+/// InputError naming the file and, for JSON syntax errors, the line and column, otherwise the
+/// JSON pointer of the offending value ("scene.json: /lights/0/intensity: expected an array
+/// of 3 numbers"): wrong types, missing keys, unknown keys and values out of range.
+SceneDescription read_scene_json(const std::string& path, const SceneFileConfig& config = {});
+
+/// Parses scene-file text; `path` names it in errors and anchors relative mesh paths.
+SceneDescription parse_scene_json(const std::string& text, const std::string& path,
+                                  const SceneFileConfig& config = {});
+
+/// A bare mesh (see `import_mesh`) with `frame_camera` and `default_lights`.
+SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& config = {});
+
+/// A camera that sees all of `bounds` from a 3/4 view (front-right, above; y is up).
+Camera frame_camera(const Bbox& bounds, float vfov_deg = 40.0f);
+
+/// A directional key light from above-left and a weaker point light at the camera (so that
+/// no visible surface is black).
+std::vector<Light> default_lights(const Bbox& bounds, const Camera& camera);
+
+/// Loads a scene path: `.json` (any case) as a scene file, anything else as a mesh; builds
+/// and bakes an explicit hierarchy. Sets load_seconds (reading) and build_seconds.
+LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config = {});
+
+}  // namespace amalgam
