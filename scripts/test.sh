@@ -11,3 +11,6 @@ ctest --preset release
 cmake --preset asan >/dev/null
 cmake --build --preset asan
 ctest --preset asan
+
+# Fuzzing: libFuzzer targets (clang), a short fixed-seed run of each (docs/reliability.md).
+bash scripts/fuzz.sh

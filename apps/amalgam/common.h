@@ -47,4 +47,11 @@ int run_trace(CommonOptions& common, const std::string& origin, const std::strin
 int run_scenes();
 int run_experiment(const std::string& name, const std::string& out_dir, bool quick, int threads);
 
+/// The arguments of `compare`.
+struct CompareOptions {
+  std::string a, b, error_image;
+  bool json = false;
+};
+int run_compare(const CompareOptions& o);
+
 }  // namespace amalgam::cli

@@ -1,4 +1,4 @@
-/// The `amalgam` command line: render, trace, scenes, experiment (see CONTRACT.md).
+/// The `amalgam` command line: render, trace, scenes, experiment, compare (see CONTRACT.md).
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -57,6 +57,15 @@ int main(int argc, char** argv) {
   experiment->add_flag("--quick", exp_quick, "small sizes (as the tests use)");
   experiment->add_option("--threads", exp_threads, "worker threads (default: all cores)");
 
+  cli::CompareOptions cmp;
+  CLI::App* compare = app.add_subcommand(
+      "compare", "compare two images: RMSE, PSNR, SSIM on luminance, mean and max error");
+  compare->add_option("a", cmp.a, "first image (.png, .pfm or .exr)")->required();
+  compare->add_option("b", cmp.b, "second image, e.g. the reference (same size)")->required();
+  compare->add_option("--error-image", cmp.error_image,
+                      "write the per-pixel RMS error in false colour (.png, .exr or .pfm)");
+  compare->add_flag("--json", cmp.json, "print the figures as JSON");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -72,6 +81,7 @@ int main(int argc, char** argv) {
     if (render->parsed()) return cli::run_render(render_opts, extras);
     if (trace->parsed()) return cli::run_trace(trace_opts, origin, direction);
     if (experiment->parsed()) return cli::run_experiment(exp_name, exp_out, exp_quick, exp_threads);
+    if (compare->parsed()) return cli::run_compare(cmp);
     return cli::run_scenes();
   } catch (const InputError& e) {
     std::cerr << "amalgam: " << e.what() << "\n";

@@ -7,26 +7,8 @@
 namespace amalgam {
 namespace {
 
-/// Unclamped slab interval [t_near, t_far] of the infinite line, with the index of the axis
-/// that produced t_near (the entry face). Returns false when the line misses the box.
 bool slab(const Ray& ray, const Bbox& box, float& t_near, float& t_far, int& near_axis) {
-  t_near = -kInfinity;
-  t_far = kInfinity;
-  near_axis = 0;
-  for (int a = 0; a < 3; ++a) {
-    const float o = ray.origin[a];
-    if (ray.dir[a] == 0.0f) {
-      if (o < box.lo[a] || o > box.hi[a]) return false;
-      continue;
-    }
-    float t0 = (box.lo[a] - o) * ray.inv_dir[a];
-    float t1 = (box.hi[a] - o) * ray.inv_dir[a];
-    if (t0 > t1) std::swap(t0, t1);
-    t1 *= 1.0f + 2.0f * gamma(3);  // Ize 2013: never lose a hit through an edge or a corner.
-    if (t0 > t_near) t_near = t0, near_axis = a;
-    if (t1 < t_far) t_far = t1;
-  }
-  return t_near <= t_far;
+  return detail::slab<true>(ray, box, t_near, t_far, near_axis);
 }
 
 }  // namespace
@@ -54,16 +36,6 @@ Vec3 offset_ray_origin(Vec3 p, Vec3 p_error, Vec3 n) {
       po[i] = std::nextafter(po[i], -kInfinity);
   }
   return po;
-}
-
-std::optional<Span> intersect_box(const Ray& ray, const Bbox& box) {
-  float t_near, t_far;
-  int axis;
-  if (!slab(ray, box, t_near, t_far, axis)) return std::nullopt;
-  const float t0 = std::max(t_near, ray.tmin);
-  const float t1 = std::min(t_far, ray.tmax);
-  if (t0 > t1) return std::nullopt;
-  return Span{t0, t1};
 }
 
 SurfaceHit box_entry_hit(const Ray& ray, const Bbox& box, float t) {
@@ -105,39 +77,20 @@ std::optional<SurfaceHit> intersect_solid_box(const Ray& ray, const Bbox& box) {
 }
 
 std::optional<SurfaceHit> intersect_triangle(const Ray& ray, Vec3 a, Vec3 b, Vec3 c) {
-  // Woop, Benthin, Wald 2013. Permute so that z is the dominant direction axis.
-  const Vec3 ad = abs(ray.dir);
-  int kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
-  int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
-  if (ray.dir[kz] < 0.0f) std::swap(kx, ky);
-  const float sx = ray.dir[kx] / ray.dir[kz];
-  const float sy = ray.dir[ky] / ray.dir[kz];
-  const float sz = 1.0f / ray.dir[kz];
-  const Vec3 A = a - ray.origin, B = b - ray.origin, C = c - ray.origin;
-  const float ax = A[kx] - sx * A[kz], ay = A[ky] - sy * A[kz];
-  const float bx = B[kx] - sx * B[kz], by = B[ky] - sy * B[kz];
-  const float cx = C[kx] - sx * C[kz], cy = C[ky] - sy * C[kz];
-  float u = cx * by - cy * bx;
-  float v = ax * cy - ay * cx;
-  float w = bx * ay - by * ax;
-  if (u == 0.0f || v == 0.0f || w == 0.0f) {  // Edge case: redo in double precision.
-    u = static_cast<float>(double(cx) * by - double(cy) * bx);
-    v = static_cast<float>(double(ax) * cy - double(ay) * cx);
-    w = static_cast<float>(double(bx) * ay - double(by) * ax);
-  }
-  if ((u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)) return std::nullopt;
-  const float det = u + v + w;
-  if (det == 0.0f) return std::nullopt;
-  const float az = sz * A[kz], bz = sz * B[kz], cz = sz * C[kz];
-  const float t = (u * az + v * bz + w * cz) / det;
-  if (!(t >= ray.tmin && t <= ray.tmax)) return std::nullopt;
+  TriangleCandidate h;
+  if (!triangle_test(ray, TrianglePre::of(ray), a, b, c, h)) return std::nullopt;
+  return triangle_finish(ray, a, b, c, h);
+}
+
+SurfaceHit triangle_finish(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, const TriangleCandidate& h) {
   Vec3 n = normalize(cross(b - a, c - a));
   if (dot(n, ray.dir) > 0) n = -n;
   // Barycentric reconstruction: the error depends on the vertices, not on the ray origin.
-  const float inv = 1.0f / det;
+  const float inv = 1.0f / h.det;
+  const float u = h.u, v = h.v, w = h.w;
   const Vec3 p = a * (u * inv) + b * (v * inv) + c * (w * inv);
   const Vec3 err = (abs(a * (u * inv)) + abs(b * (v * inv)) + abs(c * (w * inv))) * gamma(7);
-  return SurfaceHit{t, n, p, err};
+  return SurfaceHit{h.t, n, p, err};
 }
 
 std::optional<SurfaceHit> intersect_sphere(const Ray& ray, Vec3 center, float radius) {

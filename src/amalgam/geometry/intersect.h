@@ -2,8 +2,15 @@
 /// \file Ray/object intersection kernels (scalar reference versions).
 ///
 /// Each kernel is one "intersection test" in the paper's sense; the traversal counts calls.
+/// The box test is inline (it is called once per box in the traversal's inner loop); the
+/// triangle test is split into a per-ray setup (`TrianglePre`), the test proper
+/// (`triangle_test`: t and the scaled barycentrics only) and `triangle_finish` (normal, point,
+/// error bound), so a traversal can set up once per ray and finish only the closest hit.
+/// `intersect_triangle` is the three in sequence: the results are bit-identical either way.
 
+#include <algorithm>
 #include <optional>
+#include <utility>
 
 #include "amalgam/geometry/bbox.h"
 
@@ -18,7 +25,7 @@ struct Span {
 /// the far distance is enlarged by 2 gamma(3) so that rounding never loses a hit through an
 /// edge or a corner. Axis-parallel rays whose origin lies on a slab plane count as inside.
 /// Returns the overlap of [ray.tmin, ray.tmax] with the box, or nothing.
-std::optional<Span> intersect_box(const Ray& ray, const Bbox& box);
+inline std::optional<Span> intersect_box(const Ray& ray, const Bbox& box);
 
 /// A surface hit: parameter, geometric normal (unit length, facing against the ray), the
 /// hit point and a per-component bound on its absolute rounding error (for offsetting
@@ -49,6 +56,59 @@ Vec3 offset_ray_origin(Vec3 p, Vec3 p_error, Vec3 n);
 /// JCGT 2013): a ray through a shared edge or vertex hits at least one of the triangles.
 std::optional<SurfaceHit> intersect_triangle(const Ray& ray, Vec3 a, Vec3 b, Vec3 c);
 
+/// The per-ray part of the watertight test: the axis permutation (z the dominant direction
+/// axis) and the shear constants (Woop et al. 2013, section 3).
+struct TrianglePre {
+  int kx, ky, kz;
+  float sx, sy, sz;
+  static TrianglePre of(const Ray& ray) {
+    const Vec3 ad = abs(ray.dir);
+    TrianglePre p;
+    p.kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
+    p.kx = (p.kz + 1) % 3, p.ky = (p.kx + 1) % 3;
+    if (ray.dir[p.kz] < 0.0f) std::swap(p.kx, p.ky);
+    p.sx = ray.dir[p.kx] / ray.dir[p.kz];
+    p.sy = ray.dir[p.ky] / ray.dir[p.kz];
+    p.sz = 1.0f / ray.dir[p.kz];
+    return p;
+  }
+};
+
+/// An accepted triangle hit before finishing: t and the unnormalised barycentrics.
+struct TriangleCandidate {
+  float t, u, v, w, det;
+};
+
+/// The watertight test proper over [ray.tmin, ray.tmax]; fills `out` on a hit.
+inline bool triangle_test(const Ray& ray, const TrianglePre& p, Vec3 a, Vec3 b, Vec3 c,
+                          TriangleCandidate& out) {
+  // Arrays rather than Vec3::operator[] (a chain of selects): one indexed load each.
+  const Vec3 a0 = a - ray.origin, b0 = b - ray.origin, c0 = c - ray.origin;
+  const float A[3] = {a0.x, a0.y, a0.z}, B[3] = {b0.x, b0.y, b0.z}, C[3] = {c0.x, c0.y, c0.z};
+  const float ax = A[p.kx] - p.sx * A[p.kz], ay = A[p.ky] - p.sy * A[p.kz];
+  const float bx = B[p.kx] - p.sx * B[p.kz], by = B[p.ky] - p.sy * B[p.kz];
+  const float cx = C[p.kx] - p.sx * C[p.kz], cy = C[p.ky] - p.sy * C[p.kz];
+  float u = cx * by - cy * bx;
+  float v = ax * cy - ay * cx;
+  float w = bx * ay - by * ax;
+  if (u == 0.0f || v == 0.0f || w == 0.0f) [[unlikely]] {  // edge case: double precision
+    u = static_cast<float>(double(cx) * by - double(cy) * bx);
+    v = static_cast<float>(double(ax) * cy - double(ay) * cx);
+    w = static_cast<float>(double(bx) * ay - double(by) * ax);
+  }
+  if ((u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)) return false;
+  const float det = u + v + w;
+  if (det == 0.0f) return false;
+  const float az = p.sz * A[p.kz], bz = p.sz * B[p.kz], cz = p.sz * C[p.kz];
+  const float t = (u * az + v * bz + w * cz) / det;
+  if (!(t >= ray.tmin && t <= ray.tmax)) return false;
+  out = {t, u, v, w, det};
+  return true;
+}
+
+/// The full hit of a candidate from `triangle_test` on the same ray and triangle.
+SurfaceHit triangle_finish(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, const TriangleCandidate& h);
+
 /// Ray/sphere test with the numerically careful quadratic (Hearn & Baker form).
 std::optional<SurfaceHit> intersect_sphere(const Ray& ray, Vec3 center, float radius);
 
@@ -59,5 +119,51 @@ std::optional<SurfaceHit> intersect_solid_box(const Ray& ray, const Bbox& box);
 /// The hit where the ray enters a box at parameter t (from intersect_box): the point snapped
 /// onto the entry face, and that face's normal (facing the ray).
 SurfaceHit box_entry_hit(const Ray& ray, const Bbox& box, float t);
+
+namespace detail {
+
+/// Unclamped slab interval [t_near, t_far] of the infinite line (Ize 2013: t_far enlarged by
+/// 2 gamma(3)); false when the line misses the box. `near_axis`: the axis of t_near.
+template <bool kAxis>
+inline bool slab(const Ray& ray, const Bbox& box, float& t_near, float& t_far, int& near_axis) {
+  t_near = -kInfinity;
+  t_far = kInfinity;
+  near_axis = 0;
+  for (int a = 0; a < 3; ++a) {
+    const float o = ray.origin[a];
+    if (ray.dir[a] == 0.0f) {
+      if (o < box.lo[a] || o > box.hi[a]) return false;
+      continue;
+    }
+    float t0 = (box.lo[a] - o) * ray.inv_dir[a];
+    float t1 = (box.hi[a] - o) * ray.inv_dir[a];
+    if (t0 > t1) std::swap(t0, t1);
+    t1 *= 1.0f + 2.0f * gamma(3);  // Ize 2013: never lose a hit through an edge or a corner.
+    if (t0 > t_near) {
+      t_near = t0;
+      if constexpr (kAxis) near_axis = a;
+    }
+    if (t1 < t_far) t_far = t1;
+  }
+  return t_near <= t_far;
+}
+
+}  // namespace detail
+
+/// `intersect_box` without std::optional: true and [t0, t1] on a hit.
+inline bool intersect_box(const Ray& ray, const Bbox& box, float& t0, float& t1) {
+  float t_near, t_far;
+  int axis;
+  if (!detail::slab<false>(ray, box, t_near, t_far, axis)) return false;
+  t0 = std::max(t_near, ray.tmin);
+  t1 = std::min(t_far, ray.tmax);
+  return t0 <= t1;
+}
+
+inline std::optional<Span> intersect_box(const Ray& ray, const Bbox& box) {
+  float t0, t1;
+  if (!intersect_box(ray, box, t0, t1)) return std::nullopt;
+  return Span{t0, t1};
+}
 
 }  // namespace amalgam

@@ -1,128 +1,163 @@
 #include "amalgam/hierarchy/explicit.h"
 
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+
 #include <algorithm>
-#include <numeric>
+
+#include "amalgam/hierarchy/sah.h"
+#include "amalgam/math/random.h"
 
 namespace amalgam {
-namespace {
-
-float box_mean_projected_area(const Bbox& b) {
-  const Vec3 e = b.extent();
-  return 0.5f * (e.x * e.y + e.y * e.z + e.z * e.x);
-}
-
-struct Builder {
-  ExplicitHierarchy& h;
-  const BuildConfig& cfg;
-  std::vector<Vec3> centroids;
-  int max_level = 0;
-
-  // Fills node `index` with prims [begin, end) of h.prims (already permuted in place).
-  void build(std::uint32_t index, std::uint32_t begin, std::uint32_t end, int level) {
-    max_level = std::max(max_level, level + 1);
-    Bbox box;
-    for (std::uint32_t i = begin; i < end; ++i) box.extend(bounds(h.prims[i]));
-    h.nodes[index].bounds = box;
-    const std::uint32_t count = end - begin;
-    if (count <= static_cast<std::uint32_t>(cfg.leaf_size)) {
-      h.nodes[index].first = begin;
-      h.nodes[index].count = static_cast<std::uint16_t>(count);
-      h.nodes[index].leaf = true;
-      return;
-    }
-    // Split into `arity` groups of nearly equal size by repeated median splits.
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> groups{{begin, end}};
-    while (groups.size() < static_cast<std::size_t>(cfg.arity)) {
-      auto it = std::max_element(groups.begin(), groups.end(), [](auto a, auto b) {
-        return a.second - a.first < b.second - b.first;
-      });
-      auto [b, e] = *it;
-      if (e - b < 2) break;
-      Bbox cb;
-      for (std::uint32_t i = b; i < e; ++i) cb.extend(centroids[i]);
-      const Vec3 ext = cb.extent();
-      const int axis = ext.x > ext.y ? (ext.x > ext.z ? 0 : 2) : (ext.y > ext.z ? 1 : 2);
-      const std::uint32_t mid = b + (e - b) / 2;
-      std::vector<std::uint32_t> order(e - b);
-      std::iota(order.begin(), order.end(), b);
-      std::nth_element(order.begin(), order.begin() + (mid - b), order.end(),
-                       [&](std::uint32_t x, std::uint32_t y) {
-                         return centroids[x][axis] < centroids[y][axis];
-                       });
-      std::vector<Primitive> p(e - b);
-      std::vector<Vec3> c(e - b);
-      for (std::uint32_t i = 0; i < e - b; ++i) p[i] = h.prims[order[i]], c[i] = centroids[order[i]];
-      std::copy(p.begin(), p.end(), h.prims.begin() + b);
-      std::copy(c.begin(), c.end(), centroids.begin() + b);
-      *it = {b, mid};
-      groups.insert(it + 1, {mid, e});
-    }
-    const auto first = static_cast<std::uint32_t>(h.nodes.size());
-    h.nodes[index].first = first;
-    h.nodes[index].count = static_cast<std::uint16_t>(groups.size());
-    h.nodes[index].leaf = false;
-    h.nodes.resize(h.nodes.size() + groups.size());
-    for (std::size_t g = 0; g < groups.size(); ++g)
-      build(first + static_cast<std::uint32_t>(g), groups[g].first, groups[g].second, level + 1);
-  }
-};
-
-}  // namespace
 
 ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surface> materials,
                                  const BuildConfig& config) {
   ExplicitHierarchy h;
-  h.prims = std::move(prims);
   h.materials = std::move(materials);
   if (h.materials.empty()) h.materials.push_back(Surface{});
-  h.nodes.resize(1);
-  Builder b{h, config, {}, 0};
-  b.centroids.reserve(h.prims.size());
-  for (const Primitive& p : h.prims) b.centroids.push_back(bounds(p).center());
-  b.build(0, 0, static_cast<std::uint32_t>(h.prims.size()), 0);
-  h.levels = b.max_level + 1;
-  h.appearances.resize(h.nodes.size());
-  bake(h);
+  std::vector<Bbox> boxes(prims.size());
+  auto each = [&](std::size_t n, auto&& f) {
+    if (config.parallel && n > 65536)
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t i = r.begin(); i < r.end(); ++i) f(i);
+                        });
+    else
+      for (std::size_t i = 0; i < n; ++i) f(i);
+  };
+  each(prims.size(), [&](std::size_t i) { boxes[i] = bounds(prims[i]); });
+  SahConfig sc;
+  sc.arity = config.arity;
+  sc.leaf_size = config.leaf_size;
+  sc.bins = config.bins;
+  sc.parallel = config.parallel;
+  SahTree t = build_sah(boxes, sc);
+  boxes = {};
+  h.prims.resize(prims.size());
+  each(prims.size(), [&](std::size_t i) { h.prims[i] = prims[t.order[i]]; });
+  prims = {};
+  h.nodes.resize(t.nodes.size());
+  for (std::size_t i = 0; i < t.nodes.size(); ++i)
+    h.nodes[i] = {t.nodes[i].bounds, t.nodes[i].first, t.nodes[i].count, t.nodes[i].leaf};
+  h.levels = t.depth + 2;  // primitives one level below the deepest leaf
+  BakeConfig bc = config.bake;
+  bc.parallel = bc.parallel && config.parallel;
+  bake(h, bc);
   return h;
 }
 
-void bake(ExplicitHierarchy& h) {
-  h.appearances.resize(h.nodes.size());
-  // Children always have larger indices than their parent: bake in reverse order.
-  for (std::size_t i = h.nodes.size(); i-- > 0;) {
-    const ExplicitNode& n = h.nodes[i];
-    const float area = std::max(box_mean_projected_area(n.bounds), 1e-30f);
-    Vec3 colour{};
-    float weight = 0.0f, spec = 0.0f, shine = 0.0f, transmit = 1.0f;
-    for (std::uint32_t c = 0; c < n.count; ++c) {
-      float a, cover;
-      Surface s;
+namespace {
+
+/// Exact bake of node `id`: random lines traced (closest hit) against its subtree.
+BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeConfig& cfg) {
+  const int rays = std::max(cfg.rays, 1);
+  const Bbox box = h.nodes[id].bounds;
+  Vec3 colour{};
+  float spec = 0.0f, shine = 0.0f;
+  NormalTensor normals;
+  int hits = 0;
+  std::vector<std::uint32_t> stack;
+  for (int r = 0; r < rays; ++r) {
+    Sampler s(hash_combine(hash_combine(cfg.seed, id), static_cast<std::uint64_t>(r)));
+    float u[6];
+    for (float& x : u) x = s.next();
+    u[0] = (static_cast<float>(r) + u[0]) / static_cast<float>(rays);
+    Ray ray = sample_line(box, u);
+    std::optional<SurfaceHit> best;
+    std::uint32_t best_prim = 0;
+    const ExplicitNode& top = h.nodes[id];
+    if (top.leaf) {  // the common case: no stack
+      for (std::uint32_t p = top.first; p < top.first + top.count; ++p)
+        if (auto hit = intersect(h.prims[p], ray)) {
+          best = hit, best_prim = p;
+          ray.tmax = hit->t;
+        }
+    } else {
+      stack.assign(1, id);
+    }
+    while (!stack.empty()) {
+      const ExplicitNode& n = h.nodes[stack.back()];
+      stack.pop_back();
+      if (!intersect_box(ray, n.bounds)) continue;
       if (n.leaf) {
-        const Primitive& p = h.prims[n.first + c];
-        s = h.materials[p.material];
-        a = 1.0f;
-        cover = mean_projected_area(p);
+        for (std::uint32_t p = n.first; p < n.first + n.count; ++p)
+          if (auto hit = intersect(h.prims[p], ray)) {
+            best = hit, best_prim = p;
+            ray.tmax = hit->t;
+          }
       } else {
-        const Appearance& ca = h.appearances[n.first + c];
-        s = ca.surface;
-        a = ca.opacity;
-        cover = box_mean_projected_area(h.nodes[n.first + c].bounds);
+        for (std::uint32_t c = 0; c < n.count; ++c) stack.push_back(n.first + c);
       }
-      const float w = a * cover;
-      colour += s.colour * w;
-      spec += s.reflectance * w;
-      shine += s.shininess * w;
-      weight += w;
-      transmit *= 1.0f - std::min(1.0f, w / area);
     }
-    Appearance& out = h.appearances[i];
-    if (weight > 0) {
-      out.surface.colour = colour / weight;
-      out.surface.reflectance = spec / weight;
-      out.surface.shininess = shine / weight;
-    }
-    out.opacity = std::clamp(1.0f - transmit, 0.0f, 1.0f);
+    if (!best) continue;
+    ++hits;
+    const Surface& m = h.materials[h.prims[best_prim].material];
+    colour += m.colour;
+    spec += m.reflectance;
+    shine += m.shininess;
+    normals.add(best->normal, 1.0f);
   }
+  return finish_bake(rays, hits, colour, spec, shine, normals);
+}
+
+}  // namespace
+
+void bake(ExplicitHierarchy& h, const BakeConfig& config) {
+  const std::size_t n = h.nodes.size();
+  h.appearances.assign(n, Appearance{});
+  std::vector<NormalTensor> tensors(n);
+  std::vector<std::uint64_t> prims_below(n, 0);
+  std::vector<int> level(n, 0);
+  // Children always have larger indices than their parent.
+  for (std::size_t i = 0; i < n; ++i)
+    if (!h.nodes[i].leaf)
+      for (std::uint32_t c = 0; c < h.nodes[i].count; ++c)
+        level[h.nodes[i].first + c] = level[i] + 1;
+  for (std::size_t i = n; i-- > 0;) {
+    const ExplicitNode& node = h.nodes[i];
+    if (node.leaf) {
+      prims_below[i] = node.count;
+    } else {
+      for (std::uint32_t c = 0; c < node.count; ++c) prims_below[i] += prims_below[node.first + c];
+    }
+  }
+  auto bake_one = [&](std::size_t i) {
+    const ExplicitNode& node = h.nodes[i];
+    BakeResult r;
+    if (node.leaf || prims_below[i] <= static_cast<std::uint64_t>(config.exact_prims)) {
+      r = bake_exact(h, static_cast<std::uint32_t>(i), config);
+    } else {
+      BakeChild kids[kMaxChildren];
+      const int k = std::min<int>(node.count, kMaxChildren);
+      for (int c = 0; c < k; ++c)
+        kids[c] = {h.nodes[node.first + c].bounds, h.appearances[node.first + c],
+                   tensors[node.first + c]};
+      r = bake_from_children(node.bounds, std::span<const BakeChild>(kids, k), config.rays,
+                             hash_combine(config.seed, i));
+    }
+    h.appearances[i] = r.app;
+    tensors[i] = r.normals;
+  };
+  // Levels never decrease with the index in breadth-first order; but flatten() and hand-made
+  // hierarchies need only "children after parents", so group by level explicitly.
+  int max_level = 0;
+  for (int l : level) max_level = std::max(max_level, l);
+  std::vector<std::vector<std::uint32_t>> by_level(static_cast<std::size_t>(max_level) + 1);
+  for (std::size_t i = 0; i < n; ++i)
+    by_level[static_cast<std::size_t>(level[i])].push_back(static_cast<std::uint32_t>(i));
+  for (int l = max_level; l >= 0; --l) {
+    const auto& ids = by_level[static_cast<std::size_t>(l)];
+    if (config.parallel && ids.size() > 64) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 32),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t j = r.begin(); j < r.end(); ++j) bake_one(ids[j]);
+                        });
+    } else {
+      for (std::uint32_t id : ids) bake_one(id);
+    }
+  }
+  h.root_normals = n ? tensors[0] : NormalTensor{};
+  build_wide(h);
 }
 
 }  // namespace amalgam

@@ -6,15 +6,17 @@
 #include <cstdint>
 #include <vector>
 
+#include "amalgam/hierarchy/bake.h"
 #include "amalgam/hierarchy/hierarchy.h"
+#include "amalgam/hierarchy/wide.h"
 
 namespace amalgam {
 
 struct ExplicitNode {
   Bbox bounds;
-  std::uint32_t first = 0;   ///< index of the first child (node or primitive)
-  std::uint16_t count = 0;   ///< number of children
-  bool leaf = false;         ///< children are primitives
+  std::uint32_t first = 0;  ///< index of the first child (node or primitive)
+  std::uint16_t count = 0;  ///< number of children
+  bool leaf = false;        ///< children are primitives
 };
 
 class ExplicitHierarchy {
@@ -22,8 +24,13 @@ class ExplicitHierarchy {
   std::vector<ExplicitNode> nodes;
   std::vector<Appearance> appearances;  ///< one per node
   std::vector<Primitive> prims;
-  std::vector<Surface> materials;       ///< indexed by Primitive::material
+  std::vector<Surface> materials;  ///< indexed by Primitive::material
   int levels = 0;
+  /// The normal tensor (trace 1) of the root's contents, from the bake: lets an instance
+  /// level above compose normals across the instance boundary.
+  NormalTensor root_normals;
+  /// SoA child boxes for the SIMD traversal (wide.h); built by `build_wide` at the end of `bake`.
+  WideNodes wide;
 
   NodeId root() const { return 0; }
   Bbox bounds(NodeId id) const { return nodes[id].bounds; }
@@ -38,6 +45,10 @@ class ExplicitHierarchy {
     return amalgam::intersect(prims[id], ray);
   }
   Surface surface(PrimId id) const { return materials[prims[id].material]; }
+  /// The SoA child boxes when they match `nodes` (else null: the traversal's generic path).
+  const WideNodes* wide_nodes() const {
+    return !nodes.empty() && wide.headers.size() == nodes.size() ? &wide : nullptr;
+  }
   HierarchyInfo info() const {
     return {static_cast<double>(prims.size()), static_cast<double>(nodes.size()), levels};
   }
@@ -47,19 +58,24 @@ class ExplicitHierarchy {
 struct BuildConfig {
   int arity = 4;      ///< children per interior node (2..kMaxChildren)
   int leaf_size = 4;  ///< at most this many primitives in a leaf
+  int bins = 16;      ///< SAH bins per axis
+  bool parallel = true;
+  BakeConfig bake;
 };
 
-/// Builds a hierarchy over `prims` by recursive median splits along the longest centroid
-/// axis, then bakes every amalgam's appearance bottom-up (see `bake`). Empty input gives a
-/// single empty leaf.
+/// Builds a hierarchy over `prims` with a binned SAH (sah.h), collapsed to `arity`-wide
+/// nodes, in parallel, then bakes every amalgam's appearance bottom-up (see `bake`). Empty
+/// input gives a single empty leaf.
 ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surface> materials,
                                  const BuildConfig& config = {});
 
-/// Bakes appearances bottom-up. Colour: children's colours weighted by their mean projected
-/// area times opacity. Opacity: the chance that a ray crossing the node hits something,
-/// estimated with independent occluders: 1 - prod_i (1 - a_i A_i / A_node), A the mean
-/// projected area (surface area / 4 for a box).
-void bake(ExplicitHierarchy& h);
+/// Bakes appearances bottom-up, one level at a time (parallel within a level). A node with
+/// at most `config.exact_prims` primitives below it is baked exactly: `config.rays` random
+/// lines through its box (bake.h) are traced against its subtree; opacity = fraction that
+/// hit, colour = mean colour of the surfaces hit, normal = dominant axis of their normals.
+/// A larger node combines its children's baked appearances along the same kind of lines
+/// (`bake_from_children`), so the bake costs O(nodes * rays * arity) beyond the bottom.
+void bake(ExplicitHierarchy& h, const BakeConfig& config = {});
 
 /// Copies a hierarchy that can list its primitives (`src.primitive(PrimId)`) into explicit
 /// form (breadth-first node order), keeping its appearances: the same scene, for

@@ -42,7 +42,7 @@ concept Hierarchy = requires(const H& h, NodeId n, PrimId p, const Ray& r) {
   { h.root() } -> std::same_as<NodeId>;
   { h.bounds(n) } -> std::same_as<Bbox>;
   { h.appearance(n) } -> std::same_as<Appearance>;
-  { h.for_each_child(n, [](Child) { return true; }) };
+  {h.for_each_child(n, [](Child) { return true; })};
   { h.intersect(p, r) } -> std::same_as<std::optional<SurfaceHit>>;
   { h.surface(p) } -> std::same_as<Surface>;
   { h.info() } -> std::same_as<HierarchyInfo>;

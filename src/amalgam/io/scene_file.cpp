@@ -33,6 +33,19 @@ std::string fmt(double v) {
   return o.str();
 }
 
+/// Coordinates beyond this are rejected: a few times 1e19 squared overflows float, and the
+/// renderer (camera, distances, spheres) would silently produce a black image (issue 6,
+/// tests/geometry/robust_test.cpp: Degenerate.SceneJsonRejectsOrRendersExtremeInput).
+constexpr double kMaxCoordinate = 1e18;
+
+/// Fails when `b` reaches beyond +-kMaxCoordinate.
+void check_extent(const Bbox& b, const std::string& where) {
+  const double m = std::max(max_component(abs(b.lo)), max_component(abs(b.hi)));
+  if (!(m <= kMaxCoordinate))
+    throw InputError(where + ": the geometry reaches a coordinate of " + fmt(m) +
+                     ", beyond the supported range [-1e18, 1e18]");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Affine transforms (3x4, row-major).
 
@@ -159,7 +172,7 @@ class Reader {
     return "an object";
   }
 
-  double number(const Val& v, double lo = -1e30, double hi = 1e30,
+  double number(const Val& v, double lo = -kMaxCoordinate, double hi = kMaxCoordinate,
                 const char* range = nullptr) const {
     if (!v.j.is_number()) fail(v.ptr, "expected a number, found " + type(v.j));
     const double x = v.j.get<double>();
@@ -169,7 +182,10 @@ class Reader {
                       fmt(x));
     return x;
   }
-  double positive(const Val& v) const { return number(v, 1e-30, 1e30, "> 0"); }
+  double positive(const Val& v) const {
+    const bool huge = v.j.is_number() && v.j.get<double>() > kMaxCoordinate;
+    return number(v, 1e-30, kMaxCoordinate, huge ? "<= 1e18" : "> 0");
+  }
   std::int64_t integer(const Val& v, std::int64_t lo, std::int64_t hi) const {
     const std::string expected =
         "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
@@ -232,6 +248,25 @@ class Reader {
 // ---------------------------------------------------------------------------------------------
 // The scene file proper.
 
+/// Splits every triangle into 4 at its edge midpoints, `levels` times (a flat tessellation:
+/// the same surface with 4^levels times the triangles).
+ImportedMesh subdivide(const ImportedMesh& in, int levels) {
+  ImportedMesh out = in;
+  for (int l = 0; l < levels; ++l) {
+    std::vector<Primitive> next;
+    next.reserve(out.triangles.size() * 4);
+    for (const Primitive& t : out.triangles) {
+      const Vec3 ab = (t.a + t.b) * 0.5f, bc = (t.b + t.c) * 0.5f, ca = (t.c + t.a) * 0.5f;
+      next.push_back(Primitive::triangle(t.a, ab, ca, t.material));
+      next.push_back(Primitive::triangle(ab, t.b, bc, t.material));
+      next.push_back(Primitive::triangle(ca, bc, t.c, t.material));
+      next.push_back(Primitive::triangle(ab, bc, ca, t.material));
+    }
+    out.triangles = std::move(next);
+  }
+  return out;
+}
+
 struct MeshEntry {
   std::string name;
   std::shared_ptr<const ImportedMesh> mesh;
@@ -261,27 +296,68 @@ class SceneParser {
     if (auto v = r_.find(root, "meshes")) read_meshes(*v);
     std::vector<Placement> placements;
     if (auto v = r_.find(root, "instances")) placements = read_instances(*v);
+    // Expand everything when the expanded scene is small; else keep large meshes instanced.
+    double everything = static_cast<double>(spheres.size() + boxes.size() + triangles.size());
+    for (const MeshEntry& m : meshes_)
+      if (placed_.count(m.name)) everything += static_cast<double>(m.mesh->triangles.size());
+    for (const Placement& p : placements)
+      everything +=
+          static_cast<double>(p.mesh->mesh->triangles.size()) * static_cast<double>(p.where.size());
+    const bool expand_all =
+        everything <= static_cast<double>(std::min(config_.expand_limit, config_.max_triangles));
     std::uint64_t total = spheres.size() + boxes.size() + triangles.size();
+    std::uint64_t kept = 0;
     for (const MeshEntry& m : meshes_)
       if (placed_.count(m.name)) add_count(total, m.mesh->triangles.size(), m.ptr);
-    for (const Placement& p : placements)
-      add_count(total, static_cast<double>(p.mesh->mesh->triangles.size()) * p.where.size(), p.ptr);
+    for (Placement& p : placements) {
+      p.expand = expand_all || p.mesh->mesh->triangles.size() < config_.instance_min_triangles;
+      if (p.expand) {
+        add_count(total, static_cast<double>(p.mesh->mesh->triangles.size()) * p.where.size(),
+                  p.ptr);
+      } else {
+        kept += p.where.size();
+        if (kept > config_.max_instances)
+          r_.fail(p.ptr, "the scene would hold " + fmt(static_cast<double>(kept)) +
+                             " instances, more than the limit of " +
+                             fmt(static_cast<double>(config_.max_instances)));
+      }
+    }
     out_.prims.reserve(total);
+    out_.instances.reserve(kept);
 
     for (const Val& s : spheres) read_sphere(s);
     for (const Val& b : boxes) read_box(b);
     for (const Val& t : triangles) read_triangle(t);
     for (const MeshEntry& m : meshes_)
       if (placed_.count(m.name)) place(m, Affine{}, m.material);
-    for (const Placement& p : placements)
-      for (const Affine& a : p.where) place(*p.mesh, a, p.material ? p.material : p.mesh->material);
-    if (out_.prims.empty())
+    Bbox bounds;
+    for (const Placement& p : placements) {
+      const auto material = p.material ? p.material : p.mesh->material;
+      if (p.expand) {
+        for (const Affine& a : p.where) place(*p.mesh, a, material);
+      } else {
+        const std::uint32_t mesh = instanced_mesh(*p.mesh, material);
+        const Bbox object = object_bounds_[mesh];
+        for (const Affine& a : p.where) {
+          Instance in;
+          for (int i = 0; i < 3; ++i)
+            for (int k = 0; k < 4; ++k) in.to_world.m[i][k] = static_cast<float>(a.m[i][k]);
+          in.mesh = mesh;
+          out_.instances.push_back(in);
+          for (int c = 0; c < 8; ++c)
+            bounds.extend(
+                a.apply({c & 1 ? object.hi.x : object.lo.x, c & 2 ? object.hi.y : object.lo.y,
+                         c & 4 ? object.hi.z : object.lo.z}));
+        }
+      }
+    }
+    if (out_.prims.empty() && out_.instances.empty())
       r_.fail("",
               "the scene has no geometry (give meshes, spheres, boxes, triangles or "
               "instances)");
 
-    Bbox bounds;
     for (const Primitive& p : out_.prims) bounds.extend(amalgam::bounds(p));
+    check_extent(bounds, r_.file());  // transforms can scale valid input beyond the range
     if (auto c = r_.find(root, "camera"))
       out_.env.camera = read_camera(*c);
     else
@@ -299,7 +375,27 @@ class SceneParser {
     std::vector<Affine> where;
     std::optional<std::uint32_t> material;
     std::string ptr;
+    bool expand = true;  ///< into triangles, or kept as instances
   };
+
+  /// The object-space mesh of `m` with `material` (or its own materials), made once.
+  std::uint32_t instanced_mesh(const MeshEntry& m, std::optional<std::uint32_t> material) {
+    const auto key = std::make_pair(&m, material ? static_cast<std::int64_t>(*material) : -1);
+    auto it = instanced_.find(key);
+    if (it != instanced_.end()) return it->second;
+    const auto index = static_cast<std::uint32_t>(out_.meshes.size());
+    const std::size_t before = out_.prims.size();
+    place(m, Affine{}, material);  // appends world = object-space triangles to out_.prims
+    std::vector<Primitive> tris(out_.prims.begin() + static_cast<std::ptrdiff_t>(before),
+                                out_.prims.end());
+    out_.prims.resize(before);
+    Bbox b;
+    for (const Primitive& t : tris) b.extend(amalgam::bounds(t));
+    object_bounds_.push_back(b);
+    out_.meshes.push_back(std::move(tris));
+    instanced_.emplace(key, index);
+    return index;
+  }
 
   std::vector<Val> items(const Val& v) const {
     r_.array(v);
@@ -313,8 +409,9 @@ class SceneParser {
       r_.fail(ptr, "the scene would hold " + fmt(static_cast<double>(total) + more) +
                        " primitives, more than the limit of " +
                        fmt(static_cast<double>(config_.max_triangles)) +
-                       " (instances are expanded into triangles until the two-level instance "
-                       "hierarchy exists)");
+                       " (instances of meshes with fewer than " +
+                       fmt(static_cast<double>(config_.instance_min_triangles)) +
+                       " triangles are expanded into triangles)");
     total += static_cast<std::uint64_t>(more);
   }
 
@@ -422,8 +519,13 @@ class SceneParser {
       r_.fail(vs.ptr, "expected an array of 3 vertices (each an array of 3 numbers)");
     Vec3 p[3];
     for (std::size_t i = 0; i < 3; ++i) p[i] = r_.vec3(Reader::element(vs, i));
-    if (!(length(cross(p[1] - p[0], p[2] - p[0])) > 0.0f))
-      r_.fail(vs.ptr, "the triangle has zero area");
+    // Zero area, in double as the mesh importer does: in float, the cross product of a proper
+    // triangle with 1e-18 legs underflows (tests/geometry/robust_test.cpp).
+    double u[3], w[3];
+    for (int k = 0; k < 3; ++k) u[k] = double(p[1][k]) - p[0][k], w[k] = double(p[2][k]) - p[0][k];
+    const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2],
+                 cz = u[0] * w[1] - u[1] * w[0];
+    if (!(cx * cx + cy * cy + cz * cz > 0.0)) r_.fail(vs.ptr, "the triangle has zero area");
     out_.prims.push_back(Primitive::triangle(p[0], p[1], p[2], optional_material(v)));
   }
 
@@ -484,7 +586,7 @@ class SceneParser {
 
   void read_meshes(const Val& v) {
     for (const Val& m : items(v)) {
-      r_.object(m, {"file", "name", "transform", "material", "fit", "place"});
+      r_.object(m, {"file", "name", "transform", "material", "fit", "place", "subdivide"});
       const Val file = r_.require(m, "file");
       const fs::path rel = r_.string(file);
       const fs::path full = rel.is_absolute() || dir_.empty() ? rel : dir_ / rel;
@@ -509,6 +611,16 @@ class SceneParser {
         }
       }
       e.mesh = cached->second;
+      if (auto sub = r_.find(m, "subdivide")) {
+        const auto levels = static_cast<int>(r_.integer(*sub, 0, 8));
+        const double tris = static_cast<double>(e.mesh->triangles.size()) * std::pow(4.0, levels);
+        if (tris > static_cast<double>(config_.max_triangles))
+          r_.fail(sub->ptr, "subdividing " + fmt(static_cast<double>(e.mesh->triangles.size())) +
+                                " triangles " + std::to_string(levels) + " times gives " +
+                                fmt(tris) + ", more than the limit of " +
+                                fmt(static_cast<double>(config_.max_triangles)));
+        if (levels > 0) e.mesh = std::make_shared<const ImportedMesh>(subdivide(*e.mesh, levels));
+      }
       if (auto f = r_.find(m, "fit")) {
         // Uniform scale to the given largest extent, centred in x and z, resting on y = 0.
         const Bbox b = e.mesh->bounds;
@@ -617,13 +729,19 @@ class SceneParser {
   /// too many triangles (the scene-wide count is checked again once all are read).
   void add_instances_check(double count, std::size_t triangles, const std::string& ptr) const {
     const double total = count * static_cast<double>(triangles);
-    if (total > static_cast<double>(config_.max_triangles))
+    if (count > static_cast<double>(config_.max_instances))
+      r_.fail(ptr, fmt(count) + " instances, more than the limit of " +
+                       fmt(static_cast<double>(config_.max_instances)));
+    // Only meshes too small to instance are sure to be expanded at this point.
+    if (triangles < config_.instance_min_triangles &&
+        total > static_cast<double>(config_.max_triangles))
       r_.fail(ptr, fmt(count) + " instances of " + fmt(static_cast<double>(triangles)) +
                        " triangles would hold " + fmt(total) +
                        " triangles, more than the limit of " +
                        fmt(static_cast<double>(config_.max_triangles)) +
-                       " (instances are expanded into triangles until the two-level instance "
-                       "hierarchy exists)");
+                       " (instances of meshes with fewer than " +
+                       fmt(static_cast<double>(config_.instance_min_triangles)) +
+                       " triangles are expanded into triangles)");
   }
 
   void place(const MeshEntry& m, const Affine& where, std::optional<std::uint32_t> material) {
@@ -658,6 +776,8 @@ class SceneParser {
   std::set<std::string> placed_;
   std::map<std::string, const MeshEntry*> by_name_;
   std::map<const MeshEntry*, std::uint32_t> material_base_;
+  std::map<std::pair<const MeshEntry*, std::int64_t>, std::uint32_t> instanced_;
+  std::vector<Bbox> object_bounds_;  ///< per instanced mesh
 };
 
 /// Turns nlohmann's parse error into "line L, column C: what".
@@ -681,6 +801,29 @@ std::string describe_parse_error(const json::parse_error& e, const std::string& 
          ": invalid JSON: " + what;
 }
 
+/// Turns nlohmann's "number overflow parsing '1e400'" into "line L, column C: ..." by finding
+/// the quoted token in the text (found by the fuzzer, see tests/fuzz_regressions_test.cpp).
+std::string describe_overflow(const json::out_of_range& e, const std::string& text) {
+  const std::string what = e.what();
+  const auto open = what.find('\''), close = what.rfind('\'');
+  const std::string token =
+      open != std::string::npos && close > open ? what.substr(open + 1, close - open - 1) : "";
+  const std::size_t at = token.empty() ? std::string::npos : text.find(token);
+  std::string where;
+  if (at != std::string::npos) {
+    std::size_t line = 1, column = 1;
+    for (std::size_t i = 0; i < at; ++i) {
+      if (text[i] == '\n')
+        ++line, column = 1;
+      else
+        ++column;
+    }
+    where = "line " + std::to_string(line) + ", column " + std::to_string(column) + ": ";
+  }
+  return where + "invalid JSON: number " + (token.empty() ? "" : token + " ") +
+         "is out of the range of a double";
+}
+
 }  // namespace
 
 SceneDescription parse_scene_json(const std::string& text, const std::string& path,
@@ -690,6 +833,9 @@ SceneDescription parse_scene_json(const std::string& text, const std::string& pa
     doc = json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
   } catch (const json::parse_error& e) {
     throw InputError(path + ": " + describe_parse_error(e, text));
+  } catch (const json::out_of_range& e) {
+    // A number beyond double's range ("1e400"): the exception names the token, not its place.
+    throw InputError(path + ": " + describe_overflow(e, text));
   }
   return SceneParser(path, config).parse(doc);
 }
@@ -737,12 +883,29 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
   ImportConfig ic;
   ic.max_triangles = config.max_triangles;
   ImportedMesh m = import_mesh(path, ic);
+  check_extent(m.bounds, path);
   SceneDescription d;
   d.prims = std::move(m.triangles);
   d.materials = std::move(m.materials);
   d.env.camera = frame_camera(m.bounds);
   d.env.lights = default_lights(m.bounds, d.env.camera);
   return d;
+}
+
+AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config) {
+  if (d.instances.empty())
+    return build_explicit(std::move(d.prims), std::move(d.materials), config);
+  std::vector<ExplicitHierarchy> meshes;
+  meshes.reserve(d.meshes.size() + 1);
+  for (std::vector<Primitive>& m : d.meshes)
+    meshes.push_back(build_explicit(std::move(m), d.materials, config));
+  if (!d.prims.empty()) {
+    Instance loose;  // identity: traced bit-exactly as in an explicit hierarchy
+    loose.mesh = static_cast<std::uint32_t>(meshes.size());
+    meshes.push_back(build_explicit(std::move(d.prims), d.materials, config));
+    d.instances.push_back(loose);
+  }
+  return build_instanced(std::move(meshes), std::move(d.instances), config);
 }
 
 LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config) {
@@ -752,9 +915,10 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
                            ? read_scene_json(path, config)
                            : mesh_scene(path, config);
   const auto t1 = Clock::now();
-  ExplicitHierarchy h = build_explicit(std::move(d.prims), std::move(d.materials));
+  Environment env = std::move(d.env);
+  AnyHierarchy h = build_hierarchy(std::move(d));
   const auto t2 = Clock::now();
-  LoadedScene s{path, std::move(h), std::move(d.env)};
+  LoadedScene s{path, std::move(h), std::move(env)};
   s.load_seconds = std::chrono::duration<double>(t1 - t0).count();
   s.build_seconds = std::chrono::duration<double>(t2 - t1).count();
   return s;

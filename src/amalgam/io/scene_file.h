@@ -11,18 +11,35 @@
 namespace amalgam {
 
 /// Settings for reading scene paths.
+///
+/// Instancing: a scene whose primitives, with every instance expanded, number at most
+/// min(expand_limit, max_triangles) is expanded into one explicit hierarchy (one SAH over
+/// everything traces fastest). A larger one keeps each `instances` entry whose mesh has at
+/// least `instance_min_triangles` triangles as instances of a shared mesh hierarchy (the
+/// two-level InstancedHierarchy); meshes smaller than that are always expanded.
 struct SceneFileConfig {
-  /// Instances are expanded into triangles (a two-level instance hierarchy is not built yet):
-  /// a scene that would hold more primitives than this is an InputError.
+  /// Expanded primitives (loose ones plus expanded instances) beyond this are an InputError.
   std::uint64_t max_triangles = 50'000'000;
+  std::uint64_t expand_limit = 2'000'000;
+  std::uint64_t instance_min_triangles = 64;
+  /// Instances kept as instances beyond this are an InputError (about 250 bytes each).
+  std::uint64_t max_instances = 20'000'000;
 };
 
 /// A scene as described, before any hierarchy is built.
 struct SceneDescription {
-  std::vector<Primitive> prims;
+  std::vector<Primitive> prims;    ///< world space, including expanded instances
   std::vector<Surface> materials;  ///< indexed by Primitive::material; never empty
   Environment env;
+  /// Instanced meshes in object space (materials index `materials`), and their placements.
+  /// Empty unless the scene is large enough to keep instances (see SceneFileConfig).
+  std::vector<std::vector<Primitive>> meshes;
+  std::vector<Instance> instances;
 };
+
+/// The hierarchy of a described scene: explicit when it has no instances, else instanced,
+/// with the loose primitives as one more mesh placed once, untransformed.
+AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config = {});
 
 /// Reads a scene file. Relative mesh paths resolve against the file's folder. Throws
 /// InputError naming the file and, for JSON syntax errors, the line and column, otherwise the
@@ -45,7 +62,7 @@ Camera frame_camera(const Bbox& bounds, float vfov_deg = 40.0f);
 std::vector<Light> default_lights(const Bbox& bounds, const Camera& camera);
 
 /// Loads a scene path: `.json` (any case) as a scene file, anything else as a mesh; builds
-/// and bakes an explicit hierarchy. Sets load_seconds (reading) and build_seconds.
+/// and bakes its hierarchy (build_hierarchy). Sets load_seconds (reading) and build_seconds.
 LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config = {});
 
 }  // namespace amalgam

@@ -7,6 +7,8 @@
 /// and blended front to back: C = sum_k T_k a_k L_k + T_n L_hit, T_k = prod_{j<k} (1 - a_j).
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "amalgam/render/shading.h"
@@ -41,9 +43,7 @@ class Integrator {
       });
       for (const TranslucentHit& a : translucent_) {
         const Appearance app = h_.appearance(a.id);
-        colour += direct(primary, a.surf, shading_normal(app, a.surf), app.surface, key,
-                         shadow_stream) *
-                  (through * a.opacity);
+        colour += shade(primary, a.id, app, a.surf, key, shadow_stream) * (through * a.opacity);
         through *= 1.0f - a.opacity;
       }
     }
@@ -52,8 +52,7 @@ class Integrator {
       end = direct(primary, hit.surf, hit.surf.normal, h_.surface(hit.id), key, shadow_stream);
     } else if (hit.kind == TraceHit::Kind::kAmalgam) {
       const Appearance app = h_.appearance(hit.id);
-      end = direct(primary, hit.surf, shading_normal(app, hit.surf), app.surface, key,
-                   shadow_stream);
+      end = shade(primary, hit.id, app, hit.surf, key, shadow_stream);
     }
     colour += end * through;
     return {colour, hit};
@@ -64,9 +63,47 @@ class Integrator {
     return (app.normal == Vec3{}) ? s.normal : app.normal;
   }
 
-  /// Light reflected toward the viewer at a hit, one shadow ray per light.
+  /// A rendered amalgam `id` with appearance `app`, entered at `s`.
+  Vec3 shade(const Ray& primary, NodeId id, const Appearance& app, const SurfaceHit& s,
+             std::uint64_t key, std::uint64_t& stream) {
+    if (app.shading == Shading::kCloud) {
+      return direct<true>(primary, s, s.normal, app.surface, key, stream, &id);
+    }
+    return direct(primary, s, shading_normal(app, s), app.surface, key, stream);
+  }
+
+  /// Reflectance x cosine of a cloud of isotropically oriented Lambertian facets (uniform
+  /// normals over the sphere, as on a sphere or any convex body with that normal
+  /// distribution), lit from `wi` and seen from `wo`: the integral over the facets both lit
+  /// and seen of f (n.wi)(n.wo), divided by the projected area seen, pi. With the phase angle
+  /// g between wi and wo, the diffuse part is rho/pi * 2/(3 pi) (sin g + (pi - g) cos g) (the
+  /// Lambert-sphere phase function: 2/3 when lit from the viewer, 0.212 at 90 degrees, 0
+  /// back-lit); the Blinn-Phong lobe, narrow about the half vector h, gives
+  /// spec(h) * 2/(s + 1) * cos^2(g/2). Self-shadowing of the facets is part of the formula, so
+  /// a cloud's shadow rays leave its box on the light's side (see direct()).
+  static Vec3 cloud_response(const Surface& surf, Vec3 wi, Vec3 wo) {
+    constexpr float pi = std::numbers::pi_v<float>;
+    const float cos_g = std::clamp(dot(wi, wo), -1.0f, 1.0f);
+    const float g = std::acos(cos_g);
+    const float sin_g = std::sqrt(std::max(0.0f, 1.0f - cos_g * cos_g));
+    const float mean_cos = (2.0f / (3.0f * pi)) * (sin_g + (pi - g) * cos_g);
+    Vec3 f = surf.colour * (std::max(0.0f, mean_cos) / pi);
+    if (surf.reflectance > 0.0f) {
+      const float half = 0.5f * (1.0f + cos_g);  // cos^2(g/2)
+      const float spec = surf.reflectance * (surf.shininess + 8.0f) / (8.0f * pi) * 2.0f /
+                         (surf.shininess + 1.0f) * half;
+      f += Vec3{spec, spec, spec};
+    }
+    return f;
+  }
+
+  /// Light reflected toward the viewer at a hit, one shadow ray per light. With `kCloud`,
+  /// `cloud` is the rendered amalgam: it is shaded by cloud_response(), and a shadow ray
+  /// toward a light behind the entry face starts where the line toward the light leaves the
+  /// amalgam's box (its own self-shadowing is in the formula).
+  template <bool kCloud = false>
   Vec3 direct(const Ray& primary, const SurfaceHit& s, Vec3 n, const Surface& surf,
-              std::uint64_t key, std::uint64_t& stream) {
+              std::uint64_t key, std::uint64_t& stream, const NodeId* cloud = nullptr) {
     Vec3 sum{};
     const Vec3 wo = -primary.dir;
     if (dot(n, wo) < 0) n = -n;
@@ -86,14 +123,41 @@ class Integrator {
         dist = kInfinity;
         e = light.intensity;
       }
-      const float cos = dot(n, wi);
-      if (cos <= 0.0f || dot(s.normal, wi) <= 0.0f) continue;
-      Ray shadow = Ray::make(origin, wi, 0.0f, dist * (1.0f - 2.0f * gamma(3)));
+      Vec3 from = origin;
+      [[maybe_unused]] float f_cos = 1.0f;  // the cosine (the cloud has it in its response)
+      if constexpr (kCloud) {
+        if (dot(s.normal, wi) <= 0.0f) {
+          // Leave the box on the light's side: enter it backwards from beyond.
+          const Bbox box = h_.bounds(*cloud);
+          const float reach = 2.0f * length(box.hi - box.lo) + 1e-6f;
+          const auto exit = intersect_solid_box(Ray::make(s.p + wi * reach, -wi), box);
+          if (!exit) continue;
+          from = offset_ray_origin(exit->p, exit->p_error, exit->normal);
+          if (light.kind == LightKind::kPoint) {
+            const Vec3 d = light.position - from;
+            dist = length(d);
+            if (!(dist > 0.0f) || dot(d, wi) <= 0.0f) continue;  // light inside the box
+          }
+        }
+      } else {
+        f_cos = dot(n, wi);
+        if (f_cos <= 0.0f || dot(s.normal, wi) <= 0.0f) continue;
+      }
+      Ray shadow = Ray::make(from, wi, 0.0f, dist * (1.0f - 2.0f * gamma(3)));
+      // The shadow rays of one pixel leave its footprint on the surface and travel to the
+      // light: a parallel beam of the footprint's width toward a directional light, a beam
+      // narrowing to nothing at a point light. (Spreading it like the camera cone made distant
+      // occluders render as amalgams although their shadows span many pixels.)
       shadow.cone_width = primary.footprint(s.t);
-      shadow.cone_spread = primary.cone_spread;
+      shadow.cone_spread =
+          light.kind == LightKind::kPoint ? -shadow.cone_width / std::max(dist, 1e-30f) : 0.0f;
       const float tr = trav_.transmittance(shadow, hash_combine(key, stream++));
       if (tr <= 0.0f) continue;
-      sum += brdf(surf, n, wi, wo) * e * (cos * tr);
+      if constexpr (kCloud) {
+        sum += cloud_response(surf, wi, wo) * e * tr;
+      } else {
+        sum += brdf(surf, n, wi, wo) * e * (f_cos * tr);
+      }
     }
     return sum;
   }

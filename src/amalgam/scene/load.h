@@ -10,10 +10,14 @@
 #include "amalgam/builtin/prisms.h"
 #include "amalgam/builtin/tube.h"
 #include "amalgam/hierarchy/explicit.h"
+#include "amalgam/hierarchy/instanced.h"
 
 namespace amalgam {
 
-using AnyHierarchy = std::variant<ExplicitHierarchy, TubeHierarchy, PrismsHierarchy>;
+/// Every hierarchy a scene can load into; render.cpp's dispatch instantiates the traversal
+/// for each alternative and every policy combination.
+using AnyHierarchy =
+    std::variant<ExplicitHierarchy, TubeHierarchy, PrismsHierarchy, InstancedHierarchy>;
 
 struct LoadedScene {
   std::string name;

@@ -16,11 +16,24 @@
 /// contents ignored). Deterministic records each rendered translucent amalgam along a closest
 /// hit ray (for front-to-back blending by the integrator) and attenuates shadow rays by
 /// (1 - opacity) per amalgam crossed.
+///
+/// Speed (docs/benchmarks.md, "Profiling and optimisation"): the box test is inline; the
+/// sorted order keeps only (t, child) per hit child, never a copy of its box (the box is
+/// fetched again only when the LOD policy may render on that level); per ray, the
+/// watertight triangle setup is done once and a primitive hit's SurfaceHit is built only for
+/// the final closest hit. A hierarchy that exposes `wide_nodes()` (ExplicitHierarchy, see
+/// hierarchy/wide.h) and `prims` gets, in sorted order, an iterative traversal with an
+/// explicit stack that tests all children of a node at once with SIMD. The scalar reference,
+/// the original recursive traversal, is ReferenceTraversal (reference.h); the two give the
+/// same hits and the same counts (tests/traverse/simd_test.cpp).
 
 #include <algorithm>
+#include <bit>
+#include <type_traits>
 #include <vector>
 
 #include "amalgam/hierarchy/hierarchy.h"
+#include "amalgam/hierarchy/wide.h"
 #include "amalgam/math/random.h"
 #include "amalgam/stats/counters.h"
 #include "amalgam/traverse/policies.h"
@@ -48,13 +61,20 @@ struct TranslucentHit {
 
 enum class OpacityModel : std::uint8_t { kStochastic, kDeterministic };
 
+/// A hierarchy with SoA child boxes (hierarchy/wide.h) and directly addressable primitives:
+/// the traversal's fast path. `wide_nodes()` returns null when they are not built.
+template <class H>
+concept WideHierarchy = requires(const H& h, std::size_t i) {
+  { h.wide_nodes() } -> std::same_as<const WideNodes*>;
+  { h.prims[i] } -> std::convertible_to<const Primitive&>;
+};
+
 /// `Stats` is Counters (exact counts) or NullCounters (counting compiled out, to measure the
 /// counters' own overhead).
 template <Hierarchy H, class Lod, OpacityModel kOpacity, bool kSorted, class Stats = Counters>
 class Traversal {
  public:
-  Traversal(const H& h, const Lod& lod, Stats& counters)
-      : h_(h), lod_(lod), counters_(counters) {}
+  Traversal(const H& h, const Lod& lod, Stats& counters) : h_(h), lod_(lod), counters_(counters) {}
 
   /// Closest hit along `ray`. `key` seeds this ray's stochastic decisions. Under
   /// deterministic opacity, translucent amalgams in front of the returned hit are appended to
@@ -64,6 +84,7 @@ class Traversal {
     start(ray, key, RayKind::kPrimary, false);
     translucent_ = translucent;
     run();
+    if (pending_) finish_pending();
     if (translucent_) {
       const float t_hit = hit_.t;
       std::erase_if(*translucent_, [t_hit](const TranslucentHit& h) { return h.t >= t_hit; });
@@ -80,12 +101,18 @@ class Traversal {
   }
 
  private:
+  /// Whether the LOD policy can ever render (TraditionalLod never does: no box is needed
+  /// after a node's own test).
+  static constexpr bool kMayRender = !std::is_same_v<Lod, TraditionalLod>;
+  static constexpr bool kWide = WideHierarchy<H> && kSorted;
+
   void start(const Ray& ray, std::uint64_t key, RayKind kind, bool any_hit) {
     ray_ = ray;
     key_ = key;
     kind_ = kind;
     any_hit_ = any_hit;
     done_ = false;
+    pending_ = false;
     hit_ = TraceHit{};
     transmittance_ = 1.0f;
     counters_.count_ray(kind);
@@ -95,32 +122,45 @@ class Traversal {
     const NodeId root = h_.root();
     const Bbox b = h_.bounds(root);
     counters_.count_test(kind_, object_kind(0), 0);
-    if (auto span = intersect_box(ray_, b)) enter(root, 0, b, span->t0);
+    float t0, t1;
+    if (!intersect_box(ray_, b, t0, t1)) return;
+    if constexpr (kWide) {
+      if (const WideNodes* w = h_.wide_nodes()) {
+        run_wide(*w, static_cast<std::uint32_t>(root), t0);
+        return;
+      }
+    }
+    enter(root, 0, b, t0);
   }
 
   ObjectKind object_kind(int level) const {
     return lod_.may_render(level) ? ObjectKind::kAmalgam : ObjectKind::kBoundingVolume;
   }
 
-  /// A node whose box the ray meets at t_entry: render it or descend.
+  /// A node whose box the ray meets at t_entry: render it or descend. `b` is its box (only
+  /// read when the LOD policy may render).
   void enter(NodeId id, int level, const Bbox& b, float t_entry) {
     if (t_entry > ray_.tmax) return;  // a closer hit was found since this node was tested
-    if (lod_.may_render(level) &&
-        lod_.render(b, level, ray_, t_entry, t_entry <= ray_.tmin && b.contains(ray_.origin))) {
-      render(id, level, b, t_entry);
-    } else {
-      visit(id, level);
+    if constexpr (kMayRender) {
+      if (lod_.may_render(level) &&
+          lod_.render(b, level, ray_, t_entry, t_entry <= ray_.tmin && b.contains(ray_.origin))) {
+        render(id, level, b, t_entry);
+        return;
+      }
     }
+    visit(id, level);
   }
 
+  /// The generic path (any hierarchy; recursive).
   void visit(NodeId node, int level) {
     const int cl = level + 1;
     struct Entry {
       float t;
+      int slot;  ///< index into `boxes` (kept unsorted)
       NodeId id;
-      Bbox b;
     };
     Entry entries[kSorted ? kMaxChildren : 1];
+    Bbox boxes[kSorted && kMayRender ? kMaxChildren : 1];
     int n = 0;
     h_.for_each_child(node, [&](Child ch) {
       if (ch.is_primitive) {
@@ -130,24 +170,128 @@ class Traversal {
       }
       const Bbox b = h_.bounds(ch.id);
       counters_.count_test(kind_, object_kind(cl), cl);
-      const auto span = intersect_box(ray_, b);
-      if (!span) return true;
+      float t0, t1;
+      if (!intersect_box(ray_, b, t0, t1)) return true;
       if constexpr (kSorted) {
+        const int slot = n;
+        if constexpr (kMayRender) boxes[slot] = b;
         int i = n++;  // insertion sort, stable for equal t
-        while (i > 0 && entries[i - 1].t > span->t0) entries[i] = entries[i - 1], --i;
-        entries[i] = Entry{span->t0, ch.id, b};
+        while (i > 0 && entries[i - 1].t > t0) entries[i] = entries[i - 1], --i;
+        entries[i] = Entry{t0, slot, ch.id};
         return true;
       } else {
-        enter(ch.id, cl, b, span->t0);
+        enter(ch.id, cl, b, t0);
         return !done_;
       }
     });
     if constexpr (kSorted) {
       for (int i = 0; i < n && !done_; ++i) {
         if (entries[i].t > ray_.tmax) break;  // every later entry is farther still
-        enter(entries[i].id, cl, entries[i].b, entries[i].t);
+        enter(entries[i].id, cl, boxes[kMayRender ? entries[i].slot : 0], entries[i].t);
       }
     }
+  }
+
+  /// The fast path: sorted order over SoA child boxes, iterative with an explicit stack.
+  /// Pushing a node's hit children farthest-first makes the pops the same depth-first,
+  /// nearest-first order as the recursion in `visit`; a popped entry beyond the closest hit
+  /// is skipped, as `visit` breaks there (every later sibling is farther still).
+  void run_wide(const WideNodes& w, std::uint32_t root, float t_root) {
+    tri_ = TrianglePre::of(ray_);
+    wray_ = WideRay::of(ray_);
+    stack_.clear();
+    stack_.push_back({t_root, root, 0});
+    while (!stack_.empty() && !done_) {
+      const StackItem it = stack_.back();
+      stack_.pop_back();
+      if (it.t > ray_.tmax) continue;
+      if constexpr (kMayRender) {
+        if (lod_.may_render(it.level)) {
+          const Bbox b = h_.bounds(it.node);
+          if (lod_.render(b, it.level, ray_, it.t, it.t <= ray_.tmin && b.contains(ray_.origin))) {
+            render(it.node, it.level, b, it.t);
+            continue;
+          }
+        }
+      }
+      expand_wide(w, it.node, it.level);
+    }
+  }
+
+  void expand_wide(const WideNodes& w, std::uint32_t node, int level) {
+    const WideHeader hd = w.headers[node];
+    const int cl = level + 1;
+    const int count = hd.count;
+    if (hd.leaf) {
+      for (int i = 0; i < count; ++i) {
+        counters_.count_test(kind_, ObjectKind::kPrimitive, cl);
+        primitive_wide(hd.first + static_cast<std::uint32_t>(i), cl);
+        if (done_) return;
+      }
+      return;
+    }
+    const ObjectKind ok = object_kind(cl);
+    for (int i = 0; i < count; ++i) counters_.count_test(kind_, ok, cl);
+    StackItem hits[kMaxChildren];
+    int n = 0;
+    auto collect = [&](unsigned mask, const float* t, int c0) {
+      while (mask) {
+        const int lane = std::countr_zero(mask);
+        mask &= mask - 1;
+        const float te = t[lane];
+        int i = n++;  // insertion sort, stable for equal t (lanes come in stored order)
+        while (i > 0 && hits[i - 1].t > te) hits[i] = hits[i - 1], --i;
+        hits[i] = {te, hd.first + static_cast<std::uint32_t>(c0 + lane), cl};
+      }
+    };
+    const WideBox4* blk = w.blocks.data() + hd.block;
+    int c0 = 0;
+#if AMALGAM_WIDE_SSE && defined(__AVX2__)
+    for (; count - c0 > kWideLanes; c0 += 2 * kWideLanes, blk += 2) {
+      alignas(32) float t[2 * kWideLanes];
+      const int m = std::min(count - c0, 2 * kWideLanes);
+      collect(intersect_wide8(blk[0], blk[1], wray_, ray_.tmin, ray_.tmax, m, t), t, c0);
+    }
+#endif
+    for (; c0 < count; c0 += kWideLanes, ++blk) {
+      alignas(16) float t[kWideLanes];
+      const int m = std::min(count - c0, kWideLanes);
+      collect(intersect_wide4(*blk, wray_, ray_.tmin, ray_.tmax, m, t), t, c0);
+    }
+    for (int i = n; i-- > 0;) stack_.push_back(hits[i]);
+  }
+
+  /// One primitive test on the fast path: triangles with the per-ray setup and a deferred
+  /// SurfaceHit; other kinds through the full kernel (as ExplicitHierarchy::intersect).
+  void primitive_wide(std::uint32_t id, int level) {
+    const Primitive& p = h_.prims[id];
+    if (p.kind == PrimKind::kTriangle) {
+      TriangleCandidate c;
+      if (!triangle_test(ray_, tri_, p.a, p.b, p.c, c)) return;
+      if (any_hit_) {
+        transmittance_ = 0.0f;
+        done_ = true;
+        return;
+      }
+      ray_.tmax = c.t;
+      hit_.kind = TraceHit::Kind::kPrimitive;
+      hit_.t = c.t;
+      hit_.id = id;
+      hit_.level = level;
+      pending_ = true;
+      cand_ = c;
+      return;
+    }
+    if (auto s = amalgam::intersect(p, ray_)) on_primitive(id, level, *s);
+  }
+
+  /// Builds the SurfaceHit of the closest hit when it is a deferred triangle.
+  void finish_pending() {
+    if constexpr (WideHierarchy<H>) {
+      const Primitive& p = h_.prims[hit_.id];
+      hit_.surf = triangle_finish(ray_, p.a, p.b, p.c, cand_);
+    }
+    pending_ = false;
   }
 
   void on_primitive(PrimId id, int level, const SurfaceHit& s) {
@@ -157,6 +301,7 @@ class Traversal {
       return;
     }
     ray_.tmax = s.t;
+    pending_ = false;
     hit_ = TraceHit{TraceHit::Kind::kPrimitive, s.t, id, level, s};
   }
 
@@ -184,8 +329,15 @@ class Traversal {
       return;
     }
     ray_.tmax = t;
+    pending_ = false;
     hit_ = TraceHit{TraceHit::Kind::kAmalgam, t, id, level, box_entry_hit(ray_, b, t)};
   }
+
+  struct StackItem {
+    float t;
+    std::uint32_t node;
+    int level;
+  };
 
   const H& h_;
   Lod lod_;
@@ -198,6 +350,12 @@ class Traversal {
   TraceHit hit_;
   float transmittance_ = 1.0f;
   std::vector<TranslucentHit>* translucent_ = nullptr;
+  // Fast path state.
+  bool pending_ = false;  ///< hit_ is a triangle whose SurfaceHit is not built yet
+  TriangleCandidate cand_{};
+  TrianglePre tri_{};
+  WideRay wray_{};
+  std::vector<StackItem> stack_;
 };
 
 }  // namespace amalgam

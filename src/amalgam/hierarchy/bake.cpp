@@ -1,0 +1,155 @@
+#include "amalgam/hierarchy/bake.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "amalgam/hierarchy/hierarchy.h"
+#include "amalgam/math/random.h"
+
+namespace amalgam {
+
+Vec3 dominant_normal(const NormalTensor& t) {
+  const float tr = t.trace();
+  if (!(tr > 0.0f)) return {};
+  // Power iteration from the axis with the largest diagonal entry.
+  int a = 0;
+  for (int i = 1; i < 3; ++i)
+    if (t.v[i] > t.v[a]) a = i;
+  Vec3 x{};
+  x[a] = 1.0f;
+  float lambda = 0.0f;
+  for (int it = 0; it < 24; ++it) {
+    const Vec3 y = t.apply(x);
+    const float len = length(y);
+    if (!(len > 0.0f)) return {};
+    x = y / len;
+    lambda = len;
+  }
+  if (lambda < kPlanarity * tr) return {};
+  return x;
+}
+
+NormalTensor transform_tensor(const NormalTensor& t, const Vec3 rows[3]) {
+  // (M T M^T)_ij = row_i . (T row_j)
+  const Vec3 tr[3] = {t.apply(rows[0]), t.apply(rows[1]), t.apply(rows[2])};
+  NormalTensor out;
+  out.v[0] = dot(rows[0], tr[0]);
+  out.v[1] = dot(rows[1], tr[1]);
+  out.v[2] = dot(rows[2], tr[2]);
+  out.v[3] = dot(rows[0], tr[1]);
+  out.v[4] = dot(rows[1], tr[2]);
+  out.v[5] = dot(rows[2], tr[0]);
+  const float before = t.trace(), after = out.trace();
+  if (after > 0.0f) out.scale(before / after);
+  return out;
+}
+
+Ray sample_line(const Bbox& box, const float u[6]) {
+  const Vec3 e = box.extent();
+  const float area[3] = {e.y * e.z, e.z * e.x, e.x * e.y};
+  const float total = area[0] + area[1] + area[2];
+  const float reach = std::max(box.diagonal(), 1e-30f) * 1.01f + 1e-30f;
+  if (!(total > 0.0f)) {
+    // A segment or a point: a uniformly random direction through the centre.
+    const float z = 1.0f - 2.0f * u[4], r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    const float phi = 2.0f * std::numbers::pi_v<float> * u[5];
+    const Vec3 d{r * std::cos(phi), r * std::sin(phi), z};
+    return Ray::make(box.center() - d * reach, d);
+  }
+  int axis = 2;
+  float pick = u[0] * total;
+  if (pick < area[0])
+    axis = 0;
+  else if (pick < area[0] + area[1])
+    axis = 1;
+  const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+  const bool low = u[1] < 0.5f;
+  Vec3 p;
+  p[axis] = low ? box.lo[axis] : box.hi[axis];
+  p[i] = box.lo[i] + e[i] * u[2];
+  p[j] = box.lo[j] + e[j] * u[3];
+  // Cosine-weighted direction into the box.
+  const float r = std::sqrt(u[4]), phi = 2.0f * std::numbers::pi_v<float> * u[5];
+  Vec3 d;
+  d[i] = r * std::cos(phi);
+  d[j] = r * std::sin(phi);
+  d[axis] = std::sqrt(std::max(0.0f, 1.0f - u[4])) * (low ? 1.0f : -1.0f);
+  return Ray::make(p - d * reach, d);
+}
+
+BakeResult finish_bake(int rays, int hits, Vec3 colour, float spec, float shine,
+                       NormalTensor normals) {
+  BakeResult r;
+  r.app.opacity = rays > 0 ? static_cast<float>(hits) / static_cast<float>(rays) : 0.0f;
+  if (hits > 0) {
+    const float inv = 1.0f / static_cast<float>(hits);
+    r.app.surface.colour = colour * inv;
+    r.app.surface.reflectance = spec * inv;
+    r.app.surface.shininess = shine * inv;
+    const float tr = normals.trace();
+    if (tr > 0.0f) normals.scale(1.0f / tr);
+    r.normals = normals;
+    r.app.normal = dominant_normal(normals);
+    r.app.shading = r.app.normal == Vec3{} ? Shading::kCloud : Shading::kNormal;
+  }
+  return r;
+}
+
+BakeResult bake_from_children(const Bbox& box, std::span<const BakeChild> kids, int rays,
+                              std::uint64_t key) {
+  struct Entry {
+    float t;
+    int k;
+  };
+  Entry entries[kMaxChildren];
+  Vec3 colour{};
+  float spec = 0.0f, shine = 0.0f, weight = 0.0f, opacity = 0.0f;
+  NormalTensor normals;
+  rays = std::max(rays, 1);
+  for (int r = 0; r < rays; ++r) {
+    Sampler s(hash_combine(key, static_cast<std::uint64_t>(r)));
+    float u[6];
+    for (float& x : u) x = s.next();
+    u[0] = (static_cast<float>(r) + u[0]) / static_cast<float>(rays);
+    const Ray ray = sample_line(box, u);
+    int n = 0;
+    for (int k = 0; k < static_cast<int>(kids.size()) && k < kMaxChildren; ++k) {
+      if (!(kids[k].app.opacity > 0.0f)) continue;
+      const auto span = intersect_box(ray, kids[k].bounds);
+      if (!span) continue;
+      int i = n++;
+      while (i > 0 && entries[i - 1].t > span->t0) entries[i] = entries[i - 1], --i;
+      entries[i] = {span->t0, k};
+    }
+    float through = 1.0f;
+    for (int i = 0; i < n && through > 0.0f; ++i) {
+      const BakeChild& c = kids[entries[i].k];
+      const float a = std::clamp(c.app.opacity, 0.0f, 1.0f);
+      const float w = through * a;
+      colour += c.app.surface.colour * w;
+      spec += c.app.surface.reflectance * w;
+      shine += c.app.surface.shininess * w;
+      normals.add(c.normals, w);
+      weight += w;
+      through *= 1.0f - a;
+    }
+    opacity += 1.0f - through;
+  }
+  BakeResult out;
+  out.app.opacity = std::clamp(opacity / static_cast<float>(rays), 0.0f, 1.0f);
+  if (weight > 0.0f) {
+    const float inv = 1.0f / weight;
+    out.app.surface.colour = colour * inv;
+    out.app.surface.reflectance = spec * inv;
+    out.app.surface.shininess = shine * inv;
+    const float tr = normals.trace();
+    if (tr > 0.0f) normals.scale(1.0f / tr);
+    out.normals = normals;
+    out.app.normal = dominant_normal(normals);
+    out.app.shading = out.app.normal == Vec3{} ? Shading::kCloud : Shading::kNormal;
+  }
+  return out;
+}
+
+}  // namespace amalgam

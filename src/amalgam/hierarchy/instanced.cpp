@@ -1,0 +1,250 @@
+#include "amalgam/hierarchy/instanced.h"
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "amalgam/hierarchy/sah.h"
+#include "amalgam/math/random.h"
+
+namespace amalgam {
+
+bool Transform::is_identity() const {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j)
+      if (m[i][j] != (i == j ? 1.0f : 0.0f)) return false;
+  return true;
+}
+
+Transform Transform::translate(Vec3 t) {
+  Transform r;
+  r.m[0][3] = t.x, r.m[1][3] = t.y, r.m[2][3] = t.z;
+  return r;
+}
+
+Transform Transform::inverse() const {
+  double a[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) a[i][j] = m[i][j];
+  const double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+                     a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                     a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+  double inv[3][3];
+  inv[0][0] = (a[1][1] * a[2][2] - a[1][2] * a[2][1]) / det;
+  inv[0][1] = (a[0][2] * a[2][1] - a[0][1] * a[2][2]) / det;
+  inv[0][2] = (a[0][1] * a[1][2] - a[0][2] * a[1][1]) / det;
+  inv[1][0] = (a[1][2] * a[2][0] - a[1][0] * a[2][2]) / det;
+  inv[1][1] = (a[0][0] * a[2][2] - a[0][2] * a[2][0]) / det;
+  inv[1][2] = (a[0][2] * a[1][0] - a[0][0] * a[1][2]) / det;
+  inv[2][0] = (a[1][0] * a[2][1] - a[1][1] * a[2][0]) / det;
+  inv[2][1] = (a[0][1] * a[2][0] - a[0][0] * a[2][1]) / det;
+  inv[2][2] = (a[0][0] * a[1][1] - a[0][1] * a[1][0]) / det;
+  Transform r;
+  for (int i = 0; i < 3; ++i) {
+    double t = 0.0;
+    for (int j = 0; j < 3; ++j) {
+      r.m[i][j] = static_cast<float>(inv[i][j]);
+      t -= inv[i][j] * m[j][3];
+    }
+    r.m[i][3] = static_cast<float>(t);
+  }
+  return r;
+}
+
+namespace {
+
+float box_area_ratio(const InstancedHierarchy::InstanceData& in, const Bbox& object,
+                     const Bbox& world) {
+  const Vec3 e = object.extent();
+  const float transformed = 2.0f * (in.face_area[0] * e.y * e.z + in.face_area[1] * e.z * e.x +
+                                    in.face_area[2] * e.x * e.y);
+  const float outer = surface_area(world);
+  if (!(outer > 0.0f)) return 1.0f;
+  return std::clamp(transformed / outer, 0.0f, 1.0f);
+}
+
+}  // namespace
+
+Bbox InstancedHierarchy::world_box(const InstanceData& in, const Bbox& b) {
+  if (in.identity || b.empty()) return b;
+  const Vec3 c = in.to_world.point(b.center());
+  const Vec3 h = b.extent() * 0.5f;
+  Vec3 r{dot(in.abs_rows[0], h), dot(in.abs_rows[1], h), dot(in.abs_rows[2], h)};
+  r += (abs(c) + r) * (4.0f * gamma(3));  // rounding of the transform, conservatively
+  return {c - r, c + r};
+}
+
+Appearance InstancedHierarchy::appearance(NodeId n) const {
+  const std::uint64_t s = slot(n);
+  if (s == 0) return top_appearances[n];
+  const InstanceData& in = instances[s - 1];
+  const ExplicitHierarchy& mesh = meshes[in.mesh];
+  Appearance a = mesh.appearances[local(n)];
+  if (in.identity) return a;
+  const Bbox& b = mesh.nodes[local(n)].bounds;
+  a.opacity *= box_area_ratio(in, b, world_box(in, b));
+  if (a.normal != Vec3{}) {
+    const Vec3 w{dot(in.normal_rows[0], a.normal), dot(in.normal_rows[1], a.normal),
+                 dot(in.normal_rows[2], a.normal)};
+    const float len = length(w);
+    a.normal = len > 0.0f ? w / len : Vec3{};
+  }
+  return a;
+}
+
+std::optional<SurfaceHit> InstancedHierarchy::intersect(PrimId p, const Ray& ray) const {
+  const InstanceData& in = instances[slot(p) - 1];
+  const ExplicitHierarchy& mesh = meshes[in.mesh];
+  if (in.identity) return mesh.intersect(local(p), ray);
+  // Object-space ray with the direction left unnormalised: t means the same in both spaces.
+  const Ray obj =
+      Ray::make(in.to_object.point(ray.origin), in.to_object.vector(ray.dir), ray.tmin, ray.tmax);
+  auto hit = mesh.intersect(local(p), obj);
+  if (!hit) return hit;
+  SurfaceHit w;
+  w.t = hit->t;
+  Vec3 n{dot(in.normal_rows[0], hit->normal), dot(in.normal_rows[1], hit->normal),
+         dot(in.normal_rows[2], hit->normal)};
+  n = normalize(n);
+  if (dot(n, ray.dir) > 0.0f) n = -n;
+  w.normal = n;
+  w.p = in.to_world.point(hit->p);
+  // Error of the transformed point (pbrt 3, section 3.9.4): the transformed error bound plus
+  // the rounding of the transform itself.
+  const Vec3 ap = abs(hit->p);
+  Vec3 err;
+  for (int i = 0; i < 3; ++i) {
+    err[i] = (gamma(3) + 1.0f) * dot(in.abs_rows[i], hit->p_error) +
+             gamma(3) * (dot(in.abs_rows[i], ap) + std::fabs(in.to_world.m[i][3]));
+  }
+  w.p_error = err;
+  return w;
+}
+
+Primitive InstancedHierarchy::primitive(PrimId p) const {
+  const InstanceData& in = instances[slot(p) - 1];
+  Primitive q = meshes[in.mesh].prims[local(p)];
+  if (in.identity) return q;
+  if (q.kind == PrimKind::kTriangle) {
+    q.a = in.to_world.point(q.a), q.b = in.to_world.point(q.b), q.c = in.to_world.point(q.c);
+  } else {
+    // Spheres and boxes are only exact under translation; used for tests and small scenes.
+    q.a = in.to_world.point(q.a);
+    if (q.kind == PrimKind::kBox) q.b = in.to_world.point(q.b);
+  }
+  return q;
+}
+
+HierarchyInfo InstancedHierarchy::info() const {
+  HierarchyInfo i;
+  i.nodes = static_cast<double>(top_nodes.size());
+  for (const InstanceData& in : instances) {
+    i.primitives += static_cast<double>(meshes[in.mesh].prims.size());
+    i.nodes += static_cast<double>(meshes[in.mesh].nodes.size());
+  }
+  i.levels = levels;
+  return i;
+}
+
+InstancedHierarchy build_instanced(std::vector<ExplicitHierarchy> meshes,
+                                   std::vector<Instance> instances, const BuildConfig& config) {
+  InstancedHierarchy h;
+  h.meshes = std::move(meshes);
+  if (instances.size() >= 0xffffffffull)
+    throw std::invalid_argument("build_instanced: more than 2^32 - 2 instances");
+  h.instances.reserve(instances.size());
+  for (const Instance& inst : instances) {
+    if (inst.mesh >= h.meshes.size())
+      throw std::invalid_argument("build_instanced: mesh index out of range");
+    const ExplicitHierarchy& mesh = h.meshes[inst.mesh];
+    if (mesh.prims.empty()) continue;
+    InstancedHierarchy::InstanceData d;
+    d.to_world = inst.to_world;
+    d.to_object = inst.to_world.inverse();
+    d.mesh = inst.mesh;
+    d.identity = inst.to_world.is_identity();
+    const auto& m = inst.to_world.m;
+    const auto& q = d.to_object.m;
+    for (int i = 0; i < 3; ++i) {
+      d.normal_rows[i] = {q[0][i], q[1][i], q[2][i]};  // (M^-1)^T
+      d.abs_rows[i] = {std::fabs(m[i][0]), std::fabs(m[i][1]), std::fabs(m[i][2])};
+    }
+    const Vec3 col[3] = {
+        {m[0][0], m[1][0], m[2][0]}, {m[0][1], m[1][1], m[2][1]}, {m[0][2], m[1][2], m[2][2]}};
+    d.face_area[0] = length(cross(col[1], col[2]));
+    d.face_area[1] = length(cross(col[2], col[0]));
+    d.face_area[2] = length(cross(col[0], col[1]));
+    d.world_bounds = InstancedHierarchy::world_box(d, mesh.nodes[0].bounds);
+    h.instances.push_back(d);
+  }
+
+  // Top level: binned SAH over the instances' world boxes.
+  std::vector<Bbox> boxes(h.instances.size());
+  for (std::size_t i = 0; i < boxes.size(); ++i) boxes[i] = h.instances[i].world_bounds;
+  SahConfig sc;
+  sc.arity = config.arity;
+  sc.leaf_size = config.leaf_size;
+  sc.bins = config.bins;
+  sc.parallel = config.parallel;
+  const SahTree t = build_sah(boxes, sc);
+  h.top_items = t.order;
+  h.top_nodes.resize(t.nodes.size());
+  for (std::size_t i = 0; i < t.nodes.size(); ++i)
+    h.top_nodes[i] = {t.nodes[i].bounds, t.nodes[i].first, t.nodes[i].count, t.nodes[i].leaf};
+  h.levels = t.depth + 2;
+  for (std::size_t i = 0; i < t.nodes.size(); ++i) {
+    if (!t.nodes[i].leaf) continue;
+    for (std::uint32_t k = 0; k < t.nodes[i].count; ++k) {
+      const auto& in = h.instances[h.top_items[t.nodes[i].first + k]];
+      h.levels = std::max(h.levels, t.level[i] + 1 + h.meshes[in.mesh].levels);
+    }
+  }
+
+  // Bake the top level bottom-up from the instance roots.
+  h.top_appearances.assign(t.nodes.size(), Appearance{});
+  std::vector<NormalTensor> tensors(t.nodes.size());
+  const BakeConfig& bc = config.bake;
+  auto bake_one = [&](std::size_t i) {
+    const ExplicitNode& node = h.top_nodes[i];
+    BakeChild kids[kMaxChildren];
+    const int k = std::min<int>(node.count, kMaxChildren);
+    for (int c = 0; c < k; ++c) {
+      if (node.leaf) {
+        const std::uint32_t inst = h.top_items[node.first + c];
+        const auto& in = h.instances[inst];
+        const NodeId root = InstancedHierarchy::id(inst + 1ull, 0);
+        kids[c] = {in.world_bounds, h.appearance(root),
+                   in.identity ? h.meshes[in.mesh].root_normals
+                               : transform_tensor(h.meshes[in.mesh].root_normals, in.normal_rows)};
+      } else {
+        kids[c] = {h.top_nodes[node.first + c].bounds, h.top_appearances[node.first + c],
+                   tensors[node.first + c]};
+      }
+    }
+    const BakeResult r = bake_from_children(node.bounds, std::span<const BakeChild>(kids, k),
+                                            bc.rays, hash_combine(bc.seed ^ 0x70b, i));
+    h.top_appearances[i] = r.app;
+    tensors[i] = r.normals;
+  };
+  // Breadth-first order: levels never decrease with the index.
+  std::size_t end = t.nodes.size();
+  while (end > 0) {
+    std::size_t begin = end;
+    while (begin > 0 && t.level[begin - 1] == t.level[end - 1]) --begin;
+    if (config.parallel && end - begin > 64) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 16),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t i = r.begin(); i < r.end(); ++i) bake_one(i);
+                        });
+    } else {
+      for (std::size_t i = begin; i < end; ++i) bake_one(i);
+    }
+    end = begin;
+  }
+  return h;
+}
+
+}  // namespace amalgam
