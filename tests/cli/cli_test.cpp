@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -141,6 +142,47 @@ TEST(Cli, HelpForEverySubcommand) {
   EXPECT_EQ(s.status, 0);
   for (const char* name : {"builtin:line", "builtin:prisms", "builtin:poisson", "builtin:demo"})
     EXPECT_NE(s.out.find(name), std::string::npos) << name;
+}
+
+}  // namespace
+
+namespace {
+
+TEST(CliLimits, MaxMemoryFailsEarlyWithAClearMessage) {
+  const std::string err = (temp_dir() / "mem.txt").string();
+  const std::string out = (temp_dir() / "mem.png").string();
+  const CliRun r = run("render builtin:line --width 20000 --height 20000 --max-memory 100M --out " +
+                           out,
+                       err);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_FALSE(fs::exists(out));
+  std::ifstream in(err);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_NE(line.find("--max-memory"), std::string::npos) << line;
+  EXPECT_NE(line.find("GiB"), std::string::npos) << line;
+}
+
+TEST(CliLimits, ProgressBarOnlyOnATerminal) {
+  const fs::path d = temp_dir();
+  const std::string args = std::string(AMALGAM_BINARY) +
+                           " render builtin:prisms --set depth=8 --set view=corner --width 256 "
+                           "--height 256 --spp 20 --threads 1 --out " +
+                           (d / "p.pfm").string();
+  // Not a terminal: no progress bar.
+  const CliRun plain = run(args.substr(std::string(AMALGAM_BINARY).size()) + " 2>&1");
+  EXPECT_EQ(plain.out.find("ETA"), std::string::npos) << plain.out;
+  // A pseudo-terminal (util-linux `script`): the bar with its ETA appears after a second.
+  if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "no script(1)";
+  FILE* p = popen(("script -qec '" + args + "' /dev/null").c_str(), "r");
+  std::string tty;
+  char buf[4096];
+  std::size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) tty.append(buf, n);
+  pclose(p);
+  EXPECT_NE(tty.find("ETA"), std::string::npos) << tty;
+  EXPECT_NE(tty.find("spp"), std::string::npos) << tty;
+  fs::remove_all(d);
 }
 
 }  // namespace
