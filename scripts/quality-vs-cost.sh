@@ -38,13 +38,13 @@ if [[ "${1:-}" == "--quick" ]]; then
   WIDTH=64 HEIGHT=48 REF_SPP=4 KS="1 4"
   OUT=$(mktemp -d)
   DOC=$OUT/doc.md
-  trap 'rm -rf "$OUT"' EXIT
 fi
 [[ -x "$AMALGAM" ]] || { echo "quality-vs-cost: $AMALGAM not found (set AMALGAM or build first)" >&2; exit 1; }
 command -v gnuplot >/dev/null || { echo "quality-vs-cost: gnuplot not found (apt-get install gnuplot-nox)" >&2; exit 1; }
 
-work=$OUT/runs
-mkdir -p "$OUT" "$work"
+mkdir -p "$OUT"
+work=$(mktemp -d)  # every render and its stats; only the figures below are kept
+trap 'rm -rf "$work"; [[ "${1:-}" == "--quick" ]] && rm -rf "$OUT"' EXIT
 thread_args=()
 [[ "$THREADS" != 0 ]] && thread_args=(--threads "$THREADS")
 
@@ -160,7 +160,7 @@ set ylabel "RMSE vs reference"
 set y2label "tests per primary ray (with its shadow rays)"
 set y2tics
 set ytics nomirror
-set key top left
+set key below
 plot "$dat-stochastic-k.dat" u 1:2 w lp pt 5 lw 2 lc rgb "#1f77b4" t "RMSE stochastic", \
      "$dat-deterministic-k.dat" u 1:2 w lp pt 9 lw 2 lc rgb "#d62728" t "RMSE deterministic", \
      "$dat-trad-k.dat" u 1:2 w l lw 2 lc rgb "black" t "RMSE traditional", \
@@ -191,6 +191,8 @@ for r in rows:
 trad = sorted([(float(r["rmse"]), float(r["render_s"])) for r in rows if r["renderer"] == "traditional"])
 def trad_time(e):
     pts = sorted(trad, reverse=True)  # decreasing error
+    if e >= pts[0][0]:  # no more than 1 sample per pixel: its cheapest render is already better
+        return pts[0][1], " (spp 1, already lower error)"
     for (e0, t0), (e1, t1) in zip(pts, pts[1:]):
         if e1 <= e <= e0:
             f = math.log(e0 / e) / math.log(e0 / e1)
@@ -200,7 +202,7 @@ def trad_time(e):
     return t0 * (t1 / t0) ** f, " (extrapolated)"
 L.append("")
 L.append("Equal-error time ratio: the traditional render time at the same RMSE (interpolated "
-         "log-log between its spp 1/4/16 points) divided by the scale-sensitive render time; "
+         "log-log between its spp 1/4/16 points; its spp 1 time when even spp 1 has a lower error) divided by the scale-sensitive render time; "
          "above 1 the amalgams pay off.")
 L.append("")
 L.append("| opacity | K | spp | RMSE | render s | traditional s at that RMSE | ratio |")

@@ -30,10 +30,9 @@ class Integrator {
   /// Radiance along `primary`; `key` derives every random decision of this sample.
   SampleResult li(const Ray& primary, std::uint64_t key) {
     translucent_.clear();
-    const TraceHit hit = trav_.intersect(primary, hash_combine(key, 0),
-                                         kOpacity == OpacityModel::kDeterministic
-                                             ? &translucent_
-                                             : nullptr);
+    const TraceHit hit =
+        trav_.intersect(primary, hash_combine(key, 0),
+                        kOpacity == OpacityModel::kDeterministic ? &translucent_ : nullptr);
     std::uint64_t shadow_stream = 1;
     Vec3 colour{};
     float through = 1.0f;
@@ -66,10 +65,11 @@ class Integrator {
   /// A rendered amalgam `id` with appearance `app`, entered at `s`.
   Vec3 shade(const Ray& primary, NodeId id, const Appearance& app, const SurfaceHit& s,
              std::uint64_t key, std::uint64_t& stream) {
-    if (app.shading == Shading::kCloud) {
-      return direct<true>(primary, s, s.normal, app.surface, key, stream, &id);
+    if (app.shading == Shading::kFace) {
+      return direct(primary, s, shading_normal(app, s), app.surface, key, stream);
     }
-    return direct(primary, s, shading_normal(app, s), app.surface, key, stream);
+    return direct<true>(primary, s, shading_normal(app, s), app.surface, key, stream, &id,
+                        app.shading == Shading::kCloud);
   }
 
   /// Reflectance x cosine of a cloud of isotropically oriented Lambertian facets (uniform
@@ -97,13 +97,15 @@ class Integrator {
     return f;
   }
 
-  /// Light reflected toward the viewer at a hit, one shadow ray per light. With `kCloud`,
-  /// `cloud` is the rendered amalgam: it is shaded by cloud_response(), and a shadow ray
-  /// toward a light behind the entry face starts where the line toward the light leaves the
-  /// amalgam's box (its own self-shadowing is in the formula).
-  template <bool kCloud = false>
+  /// Light reflected toward the viewer at a hit, one shadow ray per light. With `kBaked`,
+  /// `amalgam` is a rendered baked amalgam: its contents, not its box, are lit, so the entry
+  /// face may be turned from a light that still reaches them; a shadow ray toward such a light
+  /// starts where the line toward the light leaves the amalgam's box (the amalgam's own
+  /// self-shadowing is in its normal's cosine or, with `cloud`, in cloud_response()).
+  template <bool kBaked = false>
   Vec3 direct(const Ray& primary, const SurfaceHit& s, Vec3 n, const Surface& surf,
-              std::uint64_t key, std::uint64_t& stream, const NodeId* cloud = nullptr) {
+              std::uint64_t key, std::uint64_t& stream, const NodeId* amalgam = nullptr,
+              bool cloud = false) {
     Vec3 sum{};
     const Vec3 wo = -primary.dir;
     if (dot(n, wo) < 0) n = -n;
@@ -124,11 +126,12 @@ class Integrator {
         e = light.intensity;
       }
       Vec3 from = origin;
-      [[maybe_unused]] float f_cos = 1.0f;  // the cosine (the cloud has it in its response)
-      if constexpr (kCloud) {
+      const float f_cos = cloud ? 1.0f : dot(n, wi);  // a cloud has it in its response
+      if (f_cos <= 0.0f) continue;
+      if constexpr (kBaked) {
         if (dot(s.normal, wi) <= 0.0f) {
           // Leave the box on the light's side: enter it backwards from beyond.
-          const Bbox box = h_.bounds(*cloud);
+          const Bbox box = h_.bounds(*amalgam);
           const float reach = 2.0f * length(box.hi - box.lo) + 1e-6f;
           const auto exit = intersect_solid_box(Ray::make(s.p + wi * reach, -wi), box);
           if (!exit) continue;
@@ -139,9 +142,8 @@ class Integrator {
             if (!(dist > 0.0f) || dot(d, wi) <= 0.0f) continue;  // light inside the box
           }
         }
-      } else {
-        f_cos = dot(n, wi);
-        if (f_cos <= 0.0f || dot(s.normal, wi) <= 0.0f) continue;
+      } else if (dot(s.normal, wi) <= 0.0f) {
+        continue;
       }
       Ray shadow = Ray::make(from, wi, 0.0f, dist * (1.0f - 2.0f * gamma(3)));
       // The shadow rays of one pixel leave its footprint on the surface and travel to the
@@ -153,11 +155,7 @@ class Integrator {
           light.kind == LightKind::kPoint ? -shadow.cone_width / std::max(dist, 1e-30f) : 0.0f;
       const float tr = trav_.transmittance(shadow, hash_combine(key, stream++));
       if (tr <= 0.0f) continue;
-      if constexpr (kCloud) {
-        sum += cloud_response(surf, wi, wo) * e * tr;
-      } else {
-        sum += brdf(surf, n, wi, wo) * e * (f_cos * tr);
-      }
+      sum += (cloud ? cloud_response(surf, wi, wo) : brdf(surf, n, wi, wo)) * e * (f_cos * tr);
     }
     return sum;
   }

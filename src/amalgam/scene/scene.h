@@ -90,7 +90,9 @@ struct Camera {
   /// a width x height film. The ray carries a cone of one pixel's angular size.
   Ray generate(float fx, float fy, int width, int height) const;
   /// The ray through the film centre: the scene's default ray for `trace`.
-  Ray centre_ray(int width, int height) const { return generate(width * 0.5f, height * 0.5f, width, height); }
+  Ray centre_ray(int width, int height) const {
+    return generate(width * 0.5f, height * 0.5f, width, height);
+  }
 };
 
 /// Lights, camera and background: everything but the geometry.
