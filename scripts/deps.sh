@@ -8,7 +8,7 @@ packages=(
   libgtest-dev libbenchmark-dev
   libassimp-dev assimp-testmodels
   libembree-dev
-  gnuplot-nox
+  gnuplot-nox python3
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -57,10 +57,21 @@ std::uint64_t film_bytes(const RenderOptions& o) {
   return pixels * (3 * sizeof(Vec3) + 3 * sizeof(std::uint64_t)) + (64u << 20);
 }
 
+std::uint64_t explicit_bytes(const ExplicitHierarchy& e) {
+  return e.nodes.size() * (sizeof(ExplicitNode) + sizeof(Appearance)) +
+         e.prims.size() * sizeof(Primitive) + e.materials.size() * sizeof(Surface);
+}
+
+/// Bytes of the scene's stored parts (the builtins' implicit hierarchies store none).
 std::uint64_t scene_bytes(const LoadedScene& s) {
-  if (const auto* e = std::get_if<ExplicitHierarchy>(&s.hierarchy))
-    return e->nodes.size() * (sizeof(ExplicitNode) + sizeof(Appearance)) +
-           e->prims.size() * sizeof(Primitive) + e->materials.size() * sizeof(Surface);
+  if (const auto* e = std::get_if<ExplicitHierarchy>(&s.hierarchy)) return explicit_bytes(*e);
+  if (const auto* in = std::get_if<InstancedHierarchy>(&s.hierarchy)) {
+    std::uint64_t b = in->top_nodes.size() * (sizeof(ExplicitNode) + sizeof(Appearance)) +
+                      in->top_items.size() * sizeof(std::uint32_t) +
+                      in->instances.size() * sizeof(InstancedHierarchy::InstanceData);
+    for (const ExplicitHierarchy& m : in->meshes) b += explicit_bytes(m);
+    return b;
+  }
   return 0;
 }
 
@@ -136,8 +147,7 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   const std::string fp = fingerprint(common);
   FilmState state;
   if (extra.resume) {
-    if (!std::filesystem::exists(ckpt))
-      throw InputError(ckpt + ": no checkpoint to resume from");
+    if (!std::filesystem::exists(ckpt)) throw InputError(ckpt + ": no checkpoint to resume from");
     state = read_checkpoint(ckpt, fp);
     if (state.spp_done > o.spp)
       throw InputError(ckpt + ": checkpoint holds " + std::to_string(state.spp_done) +
@@ -177,8 +187,8 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
     write_checkpoint(ckpt, fp, state);
     const int sig = g_signal.load();
     std::cerr << "amalgam: interrupted by " << (sig == SIGTERM ? "SIGTERM" : "SIGINT") << ": "
-              << (r.spp > 0 ? extra.out : std::string("no image")) << " holds " << r.spp
-              << " of " << o.spp << " samples per pixel; checkpoint " << ckpt
+              << (r.spp > 0 ? extra.out : std::string("no image")) << " holds " << r.spp << " of "
+              << o.spp << " samples per pixel; checkpoint " << ckpt
               << " (continue with the same command and --resume)\n";
     return 1;
   }

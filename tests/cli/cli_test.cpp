@@ -50,9 +50,11 @@ TEST(Cli, TraceLineTraditionalIsTheWorstCase) {
 
 TEST(Cli, RenderWritesImageCostImageAndStats) {
   const fs::path d = temp_dir();
-  const CliRun r = run("render builtin:prisms --set depth=4 --level 2 --width 40 --height 30 --spp 2 "
-                    "--out " + (d / "a.png").string() + " --cost-image " +
-                    (d / "c.png").string() + " --stats " + (d / "s.json").string());
+  const CliRun r =
+      run("render builtin:prisms --set depth=4 --level 2 --width 40 --height 30 --spp 2 "
+          "--out " +
+          (d / "a.png").string() + " --cost-image " + (d / "c.png").string() + " --stats " +
+          (d / "s.json").string());
   ASSERT_EQ(r.status, 0);
   EXPECT_GT(fs::file_size(d / "a.png"), 100u);
   EXPECT_GT(fs::file_size(d / "c.png"), 100u);
@@ -78,7 +80,7 @@ TEST(Cli, RenderWritesImageCostImageAndStats) {
 TEST(Cli, StatsToStdout) {
   const fs::path d = temp_dir();
   const CliRun r = run("render builtin:line --width 8 --height 8 --spp 1 --out " +
-                    (d / "l.pfm").string() + " --stats -");
+                       (d / "l.pfm").string() + " --stats -");
   ASSERT_EQ(r.status, 0);
   EXPECT_EQ(nlohmann::json::parse(r.out)["rays"]["primary"], 64);
   fs::remove_all(d);
@@ -151,9 +153,8 @@ namespace {
 TEST(CliLimits, MaxMemoryFailsEarlyWithAClearMessage) {
   const std::string err = (temp_dir() / "mem.txt").string();
   const std::string out = (temp_dir() / "mem.png").string();
-  const CliRun r = run("render builtin:line --width 20000 --height 20000 --max-memory 100M --out " +
-                           out,
-                       err);
+  const CliRun r =
+      run("render builtin:line --width 20000 --height 20000 --max-memory 100M --out " + out, err);
   EXPECT_EQ(r.status, 2);
   EXPECT_FALSE(fs::exists(out));
   std::ifstream in(err);
@@ -161,6 +162,33 @@ TEST(CliLimits, MaxMemoryFailsEarlyWithAClearMessage) {
   std::getline(in, line);
   EXPECT_NE(line.find("--max-memory"), std::string::npos) << line;
   EXPECT_NE(line.find("GiB"), std::string::npos) << line;
+}
+
+TEST(CliLimits, MaxMemoryCountsInstancedScenes) {
+  // 100,000 instances of Wuson.ply (3.7e8 triangles, kept as instances): about 21 MB of
+  // per-instance data beyond the film's 64 MiB allowance, so 80 MiB is too little.
+  const fs::path d = temp_dir();
+  {
+    std::ofstream f(d / "many.json");
+    f << R"({"meshes": [{"name": "w", "file": "/usr/share/assimp/models/PLY/Wuson.ply"}],
+             "instances": [{"mesh": "w", "grid": {"nx": 400, "nz": 250, "spacing": 2}}]})";
+  }
+  const std::string out = (d / "many.png").string(), err = (d / "err.txt").string();
+  const CliRun r = run("render " + (d / "many.json").string() +
+                           " --width 8 --height 8 --spp 1 --max-memory 80M --out " + out,
+                       err);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_FALSE(fs::exists(out));
+  std::ifstream in(err);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_NE(line.find("scene and film need"), std::string::npos) << line;
+  // With room for it, the same scene renders.
+  const CliRun ok = run("render " + (d / "many.json").string() +
+                        " --width 8 --height 8 --spp 1 --max-memory 1G --quiet --out " + out);
+  EXPECT_EQ(ok.status, 0);
+  EXPECT_TRUE(fs::exists(out));
+  fs::remove_all(d);
 }
 
 TEST(CliLimits, ProgressBarOnlyOnATerminal) {

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include "amalgam/render/shading.h"
@@ -21,11 +22,17 @@ struct SampleResult {
   TraceHit hit;
 };
 
-template <Hierarchy H, class Lod, OpacityModel kOpacity, bool kSorted, class Stats = Counters>
+/// `Tracer` finds hits: `intersect(ray, key, translucent*) -> TraceHit` and
+/// `transmittance(ray, key) -> float`. It is amalgam's Traversal; the benchmarks substitute
+/// Intel Embree (bench/field_bench.cpp) to render the same image with another ray tracer.
+template <Hierarchy H, class Lod, OpacityModel kOpacity, bool kSorted, class Stats = Counters,
+          class Tracer = Traversal<H, Lod, kOpacity, kSorted, Stats>>
 class Integrator {
  public:
   Integrator(const H& h, const Environment& env, const Lod& lod, Stats& counters)
       : h_(h), env_(env), trav_(h, lod, counters) {}
+  Integrator(const H& h, const Environment& env, Tracer tracer)
+      : h_(h), env_(env), trav_(std::move(tracer)) {}
 
   /// Radiance along `primary`; `key` derives every random decision of this sample.
   SampleResult li(const Ray& primary, std::uint64_t key) {
@@ -162,7 +169,7 @@ class Integrator {
 
   const H& h_;
   const Environment& env_;
-  Traversal<H, Lod, kOpacity, kSorted, Stats> trav_;
+  Tracer trav_;
   std::vector<TranslucentHit> translucent_;
 };
 

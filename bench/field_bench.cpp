@@ -1,0 +1,516 @@
+// Whole renders of the instanced field (scenes/field.json): Intel Embree 3 at full detail vs
+// amalgam's scale-sensitive renderer, at equal image error, and how each one's time per ray
+// grows with the field (issue 5, item 2e).
+//
+//   build/bench/amalgam_field_bench --out bench/results/field      (see scripts/bench.sh)
+//   build/bench/amalgam_field_bench --quick --out /tmp/f           (smoke run, seconds)
+//
+// Both renderers run the same code but for the ray tracer: the pass loop of render()
+// (render/passes.h) and the Integrator (direct light, one shadow ray per light, same pixel
+// sampling and random streams). Embree's tracer is `EmbreeTracer`: one Embree scene per mesh
+// (its triangles; box primitives as 12 triangles), one RTC_GEOMETRY_TYPE_INSTANCE per
+// instance with the same 3x4 transform, rtcIntersect1 for closest hits (the hit's surface is
+// then taken from amalgam's own test of that one triangle, so shading sees the same normal and
+// error bounds) and rtcOccluded1 for shadow rays. Embree renders at full detail, so its image
+// equals amalgam's traditional renderer's sample for sample (checked: the driver reports the
+// RMSE between the two).
+//
+// Part 1 (equal error): the reference is amalgam's traditional renderer at --ref-spp samples
+// (its own seed). Embree renders at each spp of --spps, amalgam scale-sensitive (stochastic
+// opacity) at each footprint K of --footprints and each spp; each image's RMSE (linear RGB,
+// all channels) against the reference and its wall time (minimum of --repeat runs, the two
+// renderers interleaved). For every amalgam render, Embree's time to reach the same error is
+// interpolated (log-log) between the Embree renders that bracket it: "equal-error speed-up" =
+// that time / amalgam's time. Where even Embree's 1-spp image has a lower error, Embree's 1-spp
+// time is used (a render has at least one sample per pixel), and the row says so.
+//
+// Views: "street" (scenes/field.json's camera, low at the field's edge: most of the frame
+// close-up) and "aerial" (the whole field from afar and above: a Wuson about a pixel wide).
+// Part 1 runs for both.
+//
+// Part 2 (growth): time per primary ray (its shadow ray included) of each, 1 spp, as the
+// field grows (a) in extent: more Wusons at the same density, 10^6 .. 10^10 triangles, the
+// street camera at the near edge; (b) in detail: the same 17,000 Wusons subdivided 0..4
+// times (6.3e7 .. 1.6e10 triangles), from both views.
+
+#include <embree3/rtcore.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "amalgam/io/image.h"
+#include "amalgam/io/metrics.h"
+#include "amalgam/io/scene_file.h"
+#include "amalgam/render/integrator.h"
+#include "amalgam/render/passes.h"
+#include "amalgam/render/render.h"
+
+namespace amalgam {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+void embree_error(void*, RTCError code, const char* str) {
+  std::fprintf(stderr, "field_bench: embree error %d: %s\n", static_cast<int>(code), str);
+  std::exit(1);
+}
+
+/// The instanced hierarchy's geometry in Embree: one scene per mesh, one instance geometry
+/// per instance (geometry ID = instance index).
+class EmbreeField {
+ public:
+  explicit EmbreeField(const InstancedHierarchy& h) {
+    const auto t0 = Clock::now();
+    device_ = rtcNewDevice(nullptr);
+    rtcSetDeviceErrorFunction(device_, embree_error, nullptr);
+    for (const ExplicitHierarchy& mesh : h.meshes) add_mesh(mesh);
+    top_ = rtcNewScene(device_);
+    rtcSetSceneBuildQuality(top_, RTC_BUILD_QUALITY_HIGH);
+    for (std::size_t i = 0; i < h.instances.size(); ++i) {
+      const InstancedHierarchy::InstanceData& in = h.instances[i];
+      RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(g, meshes_[in.mesh]);
+      rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &in.to_world.m[0][0]);
+      rtcCommitGeometry(g);
+      rtcAttachGeometryByID(top_, g, static_cast<unsigned>(i));
+      rtcReleaseGeometry(g);
+    }
+    rtcCommitScene(top_);
+    build_seconds = seconds_since(t0);
+  }
+  ~EmbreeField() {
+    rtcReleaseScene(top_);
+    for (RTCScene s : meshes_) rtcReleaseScene(s);
+    rtcReleaseDevice(device_);
+  }
+  EmbreeField(const EmbreeField&) = delete;
+  EmbreeField& operator=(const EmbreeField&) = delete;
+
+  RTCScene scene() const { return top_; }
+  /// The mesh primitive an Embree triangle of mesh `m` came from.
+  std::uint32_t prim(std::uint32_t m, std::uint32_t tri) const { return prim_of_tri_[m][tri]; }
+
+  double build_seconds = 0.0;
+
+ private:
+  void add_mesh(const ExplicitHierarchy& mesh) {
+    std::vector<float> v;
+    std::vector<std::uint32_t> idx, owner;
+    auto tri = [&](Vec3 a, Vec3 b, Vec3 c, std::uint32_t p) {
+      for (Vec3 q : {a, b, c}) {
+        idx.push_back(static_cast<std::uint32_t>(v.size() / 3));
+        v.insert(v.end(), {q.x, q.y, q.z});
+      }
+      owner.push_back(p);
+    };
+    for (std::uint32_t p = 0; p < mesh.prims.size(); ++p) {
+      const Primitive& q = mesh.prims[p];
+      if (q.kind == PrimKind::kTriangle) {
+        tri(q.a, q.b, q.c, p);
+      } else if (q.kind == PrimKind::kBox) {
+        const Vec3 lo = q.a, hi = q.b;
+        auto corner = [&](int i) {
+          return Vec3{i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z};
+        };
+        // Two triangles per face: corners differing in one bit from a face's base corner.
+        static constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                             {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+        for (const auto& f : kFaces) {
+          tri(corner(f[0]), corner(f[1]), corner(f[2]), p);
+          tri(corner(f[0]), corner(f[2]), corner(f[3]), p);
+        }
+      } else {
+        std::fprintf(stderr, "field_bench: spheres are not supported in the Embree scene\n");
+        std::exit(1);
+      }
+    }
+    RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), v.size() / 3));
+    std::copy(v.begin(), v.end(), vb);
+    auto* ib = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(std::uint32_t), idx.size() / 3));
+    std::copy(idx.begin(), idx.end(), ib);
+    rtcCommitGeometry(g);
+    RTCScene s = rtcNewScene(device_);
+    rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
+    rtcAttachGeometry(s, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(s);
+    meshes_.push_back(s);
+    prim_of_tri_.push_back(std::move(owner));
+  }
+
+  RTCDevice device_ = nullptr;
+  RTCScene top_ = nullptr;
+  std::vector<RTCScene> meshes_;
+  std::vector<std::vector<std::uint32_t>> prim_of_tri_;
+};
+
+/// The Integrator's tracer over Embree (full detail: every primitive opaque, no amalgams).
+class EmbreeTracer {
+ public:
+  EmbreeTracer(const InstancedHierarchy& h, const EmbreeField& f) : h_(&h), f_(&f) {}
+
+  TraceHit intersect(const Ray& ray, std::uint64_t, std::vector<TranslucentHit>*) {
+    RTCRayHit rh{};
+    fill(rh.ray, ray);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    rtcIntersect1(f_->scene(), &ctx, &rh);
+    TraceHit hit;
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
+    const std::uint32_t inst = rh.hit.instID[0];
+    const std::uint32_t local = f_->prim(h_->instances[inst].mesh, rh.hit.primID);
+    hit.kind = TraceHit::Kind::kPrimitive;
+    hit.id = InstancedHierarchy::id(inst + 1ull, local);
+    hit.t = rh.ray.tfar;
+    // amalgam's own test of the one primitive Embree found gives the surface (normal, point
+    // and its error bound) exactly as the traditional renderer would see it.
+    Ray again = ray;
+    again.tmax = std::min(ray.tmax, rh.ray.tfar * (1.0f + 8.0f * gamma(3)));
+    if (auto s = h_->intersect(hit.id, again)) {
+      hit.surf = *s;
+      hit.t = s->t;
+      return hit;
+    }
+    // Embree's and amalgam's watertight tests disagree on an edge: Embree's hit as it is.
+    const InstancedHierarchy::InstanceData& in = h_->instances[inst];
+    const Vec3 ng{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
+    Vec3 n = normalize(
+        Vec3{dot(in.normal_rows[0], ng), dot(in.normal_rows[1], ng), dot(in.normal_rows[2], ng)});
+    if (dot(n, ray.dir) > 0.0f) n = -n;
+    hit.surf.t = hit.t;
+    hit.surf.normal = n;
+    hit.surf.p = ray.at(hit.t);
+    hit.surf.p_error = abs(hit.surf.p) * (64.0f * gamma(1));
+    return hit;
+  }
+
+  float transmittance(const Ray& ray, std::uint64_t) {
+    RTCRay r{};
+    fill(r, ray);
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    rtcOccluded1(f_->scene(), &ctx, &r);
+    return r.tfar < 0.0f ? 0.0f : 1.0f;
+  }
+
+ private:
+  static void fill(RTCRay& r, const Ray& ray) {
+    r.org_x = ray.origin.x;
+    r.org_y = ray.origin.y;
+    r.org_z = ray.origin.z;
+    r.dir_x = ray.dir.x;
+    r.dir_y = ray.dir.y;
+    r.dir_z = ray.dir.z;
+    r.tnear = ray.tmin;
+    r.tfar = ray.tmax;
+    r.mask = 0xffffffffu;
+    r.time = 0.0f;
+    r.flags = 0;
+  }
+
+  const InstancedHierarchy* h_;
+  const EmbreeField* f_;
+};
+
+using EmbreeIntegrator = Integrator<InstancedHierarchy, TraditionalLod, OpacityModel::kStochastic,
+                                    true, Counters, EmbreeTracer>;
+
+// ---- scenes ----------------------------------------------------------------------------------
+
+/// scenes/field.json with `count` Wusons subdivided `subdivide` times, at the density of
+/// the original (17,000 in a disc of radius 110) in a disc whose near edge stays 8 units in
+/// front of the camera; the ground box covers the disc.
+/// Where the camera looks from: "street" is scenes/field.json's own camera (most of the frame
+/// close-up); "aerial" looks down on the whole field from afar, a Wuson about a pixel wide.
+struct View {
+  const char* name;
+  const char* camera;  ///< the scene file's "camera" object
+};
+constexpr View kViews[] = {
+    {"street", R"({"position": [0, 2.2, 118], "look_at": [0, 0.2, 70], "vfov": 40})"},
+    {"aerial", R"({"position": [0, 260, 420], "look_at": [0, 0, 0], "vfov": 40})"},
+};
+
+std::string field_json(long count, int subdivide, const View& view) {
+  const double radius = 110.0 * std::sqrt(static_cast<double>(count) / 17000.0);
+  const double cz = 110.0 - radius, g = radius + 15.0;
+  std::ostringstream s;
+  s.precision(9);
+  s << R"({"camera": )" << view.camera << R"(,
+  "lights": [{"type": "directional", "direction": [0.45, -1, -0.6], "intensity": [2.4, 2.3, 2.1]}],
+  "background": [0.55, 0.7, 0.9],
+  "materials": {"ground": {"colour": [0.35, 0.45, 0.25]}, "hide": {"colour": [0.8, 0.6, 0.4]}},
+  "meshes": [{"name": "wuson", "file": "/usr/share/assimp/models/PLY/Wuson.ply", "fit": 1.0,
+              "subdivide": )"
+    << subdivide << R"(, "material": "hide", "place": false}],
+  "instances": [{"mesh": "wuson", "scatter": {"count": )"
+    << count << R"(, "radius": )" << radius << R"(, "seed": 1, "centre": [0, 0, )" << cz << R"(]}}],
+  "boxes": [{"min": [)"
+    << -g << ", -0.05, " << cz - g << "], \"max\": [" << g << ", 0, " << cz + g
+    << R"(], "material": "ground"}]})";
+  return s.str();
+}
+
+struct Field {
+  LoadedScene scene;
+  std::unique_ptr<EmbreeField> embree;
+  double triangles = 0;
+  double our_build_s = 0;
+};
+
+std::unique_ptr<Field> make_field(long count, int subdivide, const View& view) {
+  auto f = std::make_unique<Field>();
+  SceneFileConfig config;
+  config.expand_limit = 0;  // always instanced, as Embree sees it
+  const auto t0 = Clock::now();
+  SceneDescription d = parse_scene_json(field_json(count, subdivide, view), "field.json", config);
+  f->scene.name = "field";
+  f->scene.env = d.env;
+  f->scene.hierarchy = build_hierarchy(std::move(d));
+  f->our_build_s = seconds_since(t0);
+  const auto& h = std::get<InstancedHierarchy>(f->scene.hierarchy);
+  f->triangles = f->scene.info().primitives;
+  f->embree = std::make_unique<EmbreeField>(h);
+  return f;
+}
+
+// ---- renders ---------------------------------------------------------------------------------
+
+struct Shot {
+  std::vector<Vec3> image;
+  double seconds = 0;
+  double tests_per_ray = 0;
+};
+
+RenderOptions options(const RenderOptions& base, int spp, RendererKind kind, float footprint,
+                      std::uint64_t seed = 0) {
+  RenderOptions o = base;
+  o.spp = spp;
+  o.renderer = kind;
+  o.footprint = footprint;
+  o.seed = seed;
+  return o;
+}
+
+Shot ours(const Field& f, const RenderOptions& o) {
+  RenderOutput r = render(f.scene, o);
+  return {std::move(r.image), r.seconds, r.per_primary.mean()};
+}
+
+Shot embree(const Field& f, const RenderOptions& o) {
+  const auto& h = std::get<InstancedHierarchy>(f.scene.hierarchy);
+  FilmState st;
+  st.width = o.width;
+  st.height = o.height;
+  st.sum.assign(static_cast<std::size_t>(o.width) * o.height, Vec3{});
+  st.tests.assign(st.sum.size(), 0);
+  const auto t0 = Clock::now();
+  render_passes(f.scene.env.camera, o, st, RenderControl{}, [&](Counters&) {
+    return EmbreeIntegrator(h, f.scene.env, EmbreeTracer(h, *f.embree));
+  });
+  const double s = seconds_since(t0);
+  return {finish(st).image, s, 0.0};
+}
+
+/// Runs a and b `repeat` times, interleaved, and keeps each one's fastest time.
+template <class A, class B>
+std::pair<Shot, Shot> interleaved(int repeat, A&& a, B&& b) {
+  Shot sa = a(), sb = b();
+  for (int i = 1; i < repeat; ++i) {
+    sa.seconds = std::min(sa.seconds, a().seconds);
+    sb.seconds = std::min(sb.seconds, b().seconds);
+  }
+  return {std::move(sa), std::move(sb)};
+}
+
+std::vector<double> parse_list(const std::string& s) {
+  std::vector<double> out;
+  std::stringstream in(s);
+  for (std::string item; std::getline(in, item, ',');) out.push_back(std::stod(item));
+  return out;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{"amalgam vs Embree on the instanced field: equal error, growth"};
+  std::string out_dir = "bench/results/field", spps_s = "1,2,4,8,16", ks_s = "1,2,4,8,16";
+  std::string counts_s = "17,170,1700,17000,170000", subdivs_s = "0,1,2,3,4";
+  int width = 512, height = 384, ref_spp = 32, repeat = 2, threads = 0;
+  bool quick = false;
+  app.add_option("--out", out_dir, "folder for results.json, CSVs and images");
+  app.add_option("--width", width);
+  app.add_option("--height", height);
+  app.add_option("--ref-spp", ref_spp, "samples per pixel of the reference");
+  app.add_option("--spps", spps_s, "samples per pixel of the measured renders");
+  app.add_option("--footprints", ks_s, "footprints K of the scale-sensitive renders");
+  app.add_option("--counts", counts_s, "Wusons in the extent sweep");
+  app.add_option("--subdivs", subdivs_s, "subdivisions in the detail sweep (17,000 Wusons)");
+  app.add_option("--repeat", repeat, "runs per timed render (fastest kept)");
+  app.add_option("--threads", threads, "threads (0: all cores)");
+  app.add_flag("--quick", quick, "smoke run: tiny images, small fields");
+  CLI11_PARSE(app, argc, argv);
+  if (quick) {
+    width = 64, height = 48, ref_spp = 4, repeat = 1;
+    spps_s = "1,2", ks_s = "1,4", counts_s = "17,170", subdivs_s = "0";
+  }
+  std::filesystem::create_directories(out_dir);
+  RenderOptions base;
+  base.width = width;
+  base.height = height;
+  base.threads = threads;
+  const std::vector<double> spps = parse_list(spps_s), ks = parse_list(ks_s);
+  std::ofstream json(out_dir + "/results.json");
+  json.precision(6);
+  json << "{\n  \"width\": " << width << ", \"height\": " << height << ", \"ref_spp\": " << ref_spp
+       << ", \"threads\": " << (threads > 0 ? threads : tbb::this_task_arena::max_concurrency())
+       << ",\n";
+
+  // Part 1: equal error on the field of scenes/field.json (17,000 Wusons, subdivided twice),
+  // from each view.
+  struct Row {
+    double spp, k, rmse, seconds, tests;
+  };
+  json << "  \"equal_error\": {";
+  for (const View& view : kViews) {
+    const long count = quick ? 170 : 17000;
+    auto f = make_field(count, 2, view);
+    std::fprintf(stderr, "%s: %.0f triangles, build ours %.2f s, embree %.2f s\n", view.name,
+                 f->triangles, f->our_build_s, f->embree->build_seconds);
+    const std::string prefix = out_dir + "/" + view.name + "-";
+    const Shot ref = ours(*f, options(base, ref_spp, RendererKind::kTraditional, 1, 9001));
+    write_image(prefix + "reference.png", width, height, ref.image);
+    // The Embree render is amalgam's traditional one sample for sample: check it.
+    const Shot trad1 = ours(*f, options(base, 1, RendererKind::kTraditional, 1));
+    std::vector<Row> e_rows, a_rows;
+    double same_rmse = 0;
+    for (double spp : spps) {
+      const RenderOptions oe = options(base, static_cast<int>(spp), RendererKind::kTraditional, 1);
+      Shot e = embree(*f, oe);
+      for (int i = 1; i < repeat; ++i) e.seconds = std::min(e.seconds, embree(*f, oe).seconds);
+      if (spp == 1) same_rmse = rmse(e.image, trad1.image);
+      e_rows.push_back({spp, 0, rmse(e.image, ref.image), e.seconds, 0});
+      std::fprintf(stderr, "%s: embree spp %g: rmse %.5f, %.3f s\n", view.name, spp,
+                   e_rows.back().rmse, e.seconds);
+      if (spp == spps.front()) write_image(prefix + "embree.png", width, height, e.image);
+      for (double k : ks) {
+        const RenderOptions oa = options(base, static_cast<int>(spp), RendererKind::kScaleSensitive,
+                                         static_cast<float>(k));
+        Shot a = ours(*f, oa);
+        for (int i = 1; i < repeat; ++i) a.seconds = std::min(a.seconds, ours(*f, oa).seconds);
+        a_rows.push_back({spp, k, rmse(a.image, ref.image), a.seconds, a.tests_per_ray});
+        std::fprintf(stderr, "%s: amalgam K %g spp %g: rmse %.5f, %.3f s\n", view.name, k, spp,
+                     a_rows.back().rmse, a.seconds);
+        if (spp == spps.front() && k == ks.front())
+          write_image(prefix + "amalgam.png", width, height, a.image);
+      }
+    }
+    // Embree's time at amalgam's error: log-log interpolation along its spp curve.
+    auto embree_time_at = [&](double err, bool& floor) {
+      floor = false;
+      if (err >= e_rows.front().rmse) {
+        floor = true;
+        return e_rows.front().seconds;
+      }
+      for (std::size_t i = 1; i < e_rows.size(); ++i) {
+        const Row &lo = e_rows[i - 1], &hi = e_rows[i];
+        if (err >= hi.rmse) {
+          const double w = std::log(err / lo.rmse) / std::log(hi.rmse / lo.rmse);
+          return std::exp(std::log(lo.seconds) + w * std::log(hi.seconds / lo.seconds));
+        }
+      }
+      return std::numeric_limits<double>::quiet_NaN();  // below Embree's best measured error
+    };
+    json << (&view == kViews ? "\n" : ",\n") << "   \"" << view.name
+         << "\": {\"triangles\": " << f->triangles
+         << ", \"embree_vs_traditional_rmse\": " << same_rmse << ",\n    \"embree\": [";
+    for (std::size_t i = 0; i < e_rows.size(); ++i)
+      json << (i ? ", " : "") << "{\"spp\": " << e_rows[i].spp << ", \"rmse\": " << e_rows[i].rmse
+           << ", \"seconds\": " << e_rows[i].seconds << "}";
+    json << "],\n    \"amalgam\": [";
+    for (std::size_t i = 0; i < a_rows.size(); ++i) {
+      bool floor = false;
+      const double te = embree_time_at(a_rows[i].rmse, floor);
+      json << (i ? ",\n      " : "") << "{\"spp\": " << a_rows[i].spp
+           << ", \"footprint\": " << a_rows[i].k << ", \"rmse\": " << a_rows[i].rmse
+           << ", \"seconds\": " << a_rows[i].seconds << ", \"tests_per_ray\": " << a_rows[i].tests
+           << ", \"embree_seconds_at_equal_error\": ";
+      if (std::isnan(te))
+        json << "null";
+      else
+        json << te;
+      json << ", \"embree_floor\": " << (floor ? "true" : "false") << "}";
+    }
+    json << "]}";
+  }
+  json << "},\n";
+
+  // Part 2: time per primary ray (with its shadow ray) as the field grows.
+  auto sweep = [&](const char* name, const View& view,
+                   const std::vector<std::pair<long, int>>& fields) {
+    json << "  \"" << name << "\": [";
+    bool first = true;
+    for (auto [count, sub] : fields) {
+      auto f = make_field(count, sub, view);
+      const RenderOptions oa = options(base, 1, RendererKind::kScaleSensitive, 1);
+      const RenderOptions oe = options(base, 1, RendererKind::kTraditional, 1);
+      auto [a, e] = interleaved(
+          repeat, [&] { return ours(*f, oa); }, [&] { return embree(*f, oe); });
+      const double rays = static_cast<double>(width) * height;
+      std::fprintf(stderr,
+                   "%s: %ld wusons x subdivide %d = %.3g triangles: amalgam %.3f us/ray "
+                   "(%.1f tests), embree %.3f us/ray; build ours %.2f s, embree %.2f s\n",
+                   name, count, sub, f->triangles, 1e6 * a.seconds / rays, a.tests_per_ray,
+                   1e6 * e.seconds / rays, f->our_build_s, f->embree->build_seconds);
+      json << (first ? "\n    " : ",\n    ") << "{\"instances\": " << count
+           << ", \"subdivide\": " << sub << ", \"triangles\": " << f->triangles
+           << ", \"amalgam_us_per_ray\": " << 1e6 * a.seconds / rays
+           << ", \"amalgam_tests_per_ray\": " << a.tests_per_ray
+           << ", \"embree_us_per_ray\": " << 1e6 * e.seconds / rays
+           << ", \"amalgam_build_s\": " << f->our_build_s
+           << ", \"embree_build_s\": " << f->embree->build_seconds << "}";
+      first = false;
+    }
+    json << "]";
+  };
+  std::vector<std::pair<long, int>> extent, detail;
+  for (double c : parse_list(counts_s)) extent.emplace_back(static_cast<long>(c), 2);
+  for (double s : parse_list(subdivs_s))
+    detail.emplace_back(quick ? 170 : 17000, static_cast<int>(s));
+  sweep("extent_street", kViews[0], extent);
+  json << ",\n";
+  sweep("detail_street", kViews[0], detail);
+  json << ",\n";
+  sweep("detail_aerial", kViews[1], detail);
+  json << "\n}\n";
+  return 0;
+}
+
+}  // namespace
+}  // namespace amalgam
+
+int main(int argc, char** argv) {
+  try {
+    return amalgam::run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "field_bench: %s\n", e.what());
+    return 1;
+  }
+}

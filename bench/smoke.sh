@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Smoke run of every benchmark and of the report generator (seconds; no timing is judged):
+#   bench/smoke.sh BUILD_DIR
+# Runs amalgam_embree_bench on the smallest scene, amalgam_bench, amalgam_field_bench --quick,
+# then scripts/bench_report.py on copies of README.md and docs/benchmarks.md, all in a
+# temporary directory. Registered as the ctest `bench_smoke`; `scripts/bench.sh --quick` runs it.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=$(cd "$1" && pwd)
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+"$build/bench/amalgam_embree_bench" --benchmark_filter='tiny.*threads:1' \
+  --benchmark_min_time=0.01 --benchmark_out="$out/embree.json" --benchmark_out_format=json \
+  2>"$out/embree.log" >/dev/null
+grep -q '^agreement tiny_wuson' "$out/embree.log"
+"$build/bench/amalgam_bench" --benchmark_min_time=0.01 >/dev/null
+"$build/bench/amalgam_field_bench" --quick --out "$out/field" 2>/dev/null
+cp "$root/README.md" "$root/docs/benchmarks.md" "$out/"
+python3 "$root/scripts/bench_report.py" "$out/embree.json" "$out/embree.log" \
+  "$out/field/results.json" "$out/benchmarks.md" "$out/README.md" >/dev/null
+grep -q 'target (issue 5)' "$out/README.md"
+echo "bench smoke: ok"

@@ -1,0 +1,96 @@
+#pragma once
+/// \file The progressive pass loop of a render, independent of what traces the rays: render()
+/// runs it with amalgam's Integrator over a hierarchy; bench/field_bench.cpp runs it with the
+/// same Integrator over Intel Embree, so both images come from one loop and one sampling.
+
+#include <oneapi/tbb/blocked_range2d.h>
+#include <oneapi/tbb/enumerable_thread_specific.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include "amalgam/math/random.h"
+#include "amalgam/render/render.h"
+
+namespace amalgam {
+
+/// Adds samples st.spp_done .. o.spp - 1 to `st` (sized for o.width x o.height), in passes of
+/// whole samples per pixel over 8x8 tiles on o.threads threads (0: all). Pixel (x, y),
+/// sample s uses the random stream hash(o.seed, y * width + x, s), so the result does not
+/// depend on the thread count. `make(counters)` returns an integrator for one tile (an object
+/// with `li(ray, key)` returning a SampleResult) that counts its tests into `counters`.
+/// Returns whether control.cancel stopped the render early.
+template <class MakeIntegrator>
+bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
+                   const RenderControl& control, MakeIntegrator&& make) {
+  struct ThreadState {
+    Counters counters;
+    CostDistribution per_primary;
+  };
+  const std::size_t pixels = static_cast<std::size_t>(o.width) * o.height;
+  // Samples per pass: whole samples for every pixel, about 2^16 primary rays per pass so that
+  // small images do not pay for many passes and large ones can stop quickly.
+  const int per_pass = std::max(1, static_cast<int>(65536 / std::max<std::size_t>(pixels, 1)));
+  const int threads = o.threads > 0 ? o.threads : tbb::this_task_arena::max_concurrency();
+  tbb::task_arena arena(threads);
+  std::vector<Vec3> pass_sum;
+  std::vector<std::uint64_t> pass_tests;
+  while (st.spp_done < o.spp) {
+    const int s0 = st.spp_done, s1 = std::min(o.spp, s0 + per_pass);
+    pass_sum = st.sum;  // continue each pixel's running sum in sample order
+    pass_tests = st.tests;
+    tbb::enumerable_thread_specific<ThreadState> states;
+    std::atomic<bool> stopped{false};
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range2d<int>(0, o.height, 8, 0, o.width, 8),
+                        [&](const tbb::blocked_range2d<int>& r) {
+                          if (control.cancel && control.cancel->load(std::memory_order_relaxed)) {
+                            stopped.store(true, std::memory_order_relaxed);
+                            return;
+                          }
+                          ThreadState& ts = states.local();
+                          auto integrator = make(ts.counters);
+                          for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
+                            for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+                              const std::size_t pix = static_cast<std::size_t>(y) * o.width + x;
+                              const std::uint64_t pixel_key = hash_combine(o.seed, pix);
+                              Vec3 sum = pass_sum[pix];
+                              std::uint64_t tests = 0;
+                              for (int s = s0; s < s1; ++s) {
+                                const std::uint64_t key =
+                                    hash_combine(pixel_key, static_cast<std::uint64_t>(s));
+                                Sampler jitter(hash_combine(key, 0x6a177e5));
+                                const float fx = static_cast<float>(x) + jitter.next();
+                                const float fy = static_cast<float>(y) + jitter.next();
+                                const Ray ray = camera.generate(fx, fy, o.width, o.height);
+                                const std::uint64_t before = ts.counters.total();
+                                sum += integrator.li(ray, key).colour;
+                                const std::uint64_t cost = ts.counters.total() - before;
+                                ts.per_primary.add(cost);
+                                tests += cost;
+                              }
+                              pass_sum[pix] = sum;
+                              pass_tests[pix] += tests;
+                            }
+                          }
+                        });
+    });
+    if (stopped.load()) return true;  // the pass is incomplete: discard it
+    st.sum.swap(pass_sum);
+    st.tests.swap(pass_tests);
+    for (const ThreadState& ts : states) {
+      st.counters.merge(ts.counters);
+      st.per_primary.merge(ts.per_primary);
+    }
+    st.spp_done = s1;
+    if (control.on_pass) control.on_pass(st);
+    if (control.cancel && control.cancel->load() && st.spp_done < o.spp) return true;
+  }
+  return false;
+}
+
+}  // namespace amalgam
