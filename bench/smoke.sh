@@ -9,7 +9,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build=$(cd "$1" && pwd)
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-"$build/bench/amalgam_embree_bench" --benchmark_filter='tiny.*threads:1' \
+"$build/bench/amalgam_embree_bench" --benchmark_filter='Build/tiny|Rays/tiny.*threads:1' \
   --benchmark_min_time=0.01 --benchmark_out="$out/embree.json" --benchmark_out_format=json \
   2>"$out/embree.log" >/dev/null
 grep -q '^agreement tiny_wuson' "$out/embree.log"

@@ -197,9 +197,10 @@ for name, what in SWEEPS:
     gt, _, _ = growth(field[name], "amalgam_tests_per_ray")
     R.append("| scale-sensitive time per ray grows <= 1.2x from 10^6 to 10^10 triangles, Embree's grows | %s, %.3g -> %.3g triangles: amalgam %.2fx (tests per ray %.2fx), Embree %.2fx | %s | `build/bench/amalgam_field_bench` |"
              % (name.replace("_", " "), lo_t, hi_t, ga, gt, ge, yes(ga <= 1.2 and ge > 1.0)))
-R.append("| build + bake within 2x of Embree's build | %.2f-%.2fx (%d scenes, up to %d triangles) | %s | `build/bench/amalgam_embree_bench --benchmark_filter=Build` |"
-         % (min(bratios), max(bratios), len(bratios), max(b["triangles"] for b in builds.values()),
-            yes(max(bratios) <= 2.0)))
+if bratios:
+    R.append("| build + bake within 2x of Embree's build | %.2f-%.2fx (%d scenes, up to %d triangles) | %s | `build/bench/amalgam_embree_bench --benchmark_filter=Build` |"
+             % (min(bratios), max(bratios), len(bratios), max(b["triangles"] for b in builds.values()),
+                yes(max(bratios) <= 2.0)))
 R.append("")
 R.append("Single-ray throughput, 1 thread (Mrays/s):\n")
 R.append("| scene | triangles | primary ours / Embree | ratio | shadow ours / Embree | ratio | random ours / Embree | ratio |")

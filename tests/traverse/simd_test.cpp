@@ -1,12 +1,14 @@
-// Differential tests of the fast traversal (traverse.h: SIMD child boxes from hierarchy/wide.h,
-// iterative stack, per-ray triangle setup, deferred SurfaceHit) against the scalar reference
-// (reference.h, the original recursive traversal): on random rays over a real mesh and over
-// the builtins, the same hit (kind, id, level; t within 1e-6 relative; the same surface), the
-// same transmittance and the same counts per ray kind, object kind and level, for every
-// combination of LOD policy, opacity model and child order.
+// Differential tests of the fast traversal (traverse.h: SIMD child boxes and triangle packs
+// from hierarchy/wide.h, iterative stack, per-ray triangle setup, deferred SurfaceHit): the
+// SIMD kernels against the scalar ones lane by lane, and the traversal against the scalar
+// reference (reference.h, the original recursive traversal): on random rays over a real mesh
+// and over the builtins, the same hit (kind, id, level; t within 1e-6 relative; the same
+// surface), the same transmittance and the same counts per ray kind, object kind and level,
+// for every combination of LOD policy, opacity model and child order.
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -170,6 +172,135 @@ TEST(SimdTraversal, TriangleSplitMatchesWholeTest) {
       EXPECT_EQ(s.p[k], whole->p[k]);
       EXPECT_EQ(s.normal[k], whole->normal[k]);
     }
+  }
+}
+
+/// Packs of four triangles for the pack kernel: on a coarse integer lattice (so triangles
+/// share edges and vertices exactly and rays through lattice points cross edges and vertices
+/// exactly: u, v or w is 0, the double-precision case), some degenerate (a repeated vertex,
+/// three collinear vertices, all three equal), some duplicated (equal t in two lanes), the
+/// rest random.
+TrianglePack4 random_pack(std::mt19937& rng, int i, Vec3 tri[kWideLanes][3]) {
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::uniform_int_distribution<int> grid(-2, 2);
+  auto lattice = [&] { return Vec3{float(grid(rng)), float(grid(rng)), float(grid(rng))}; };
+  TrianglePack4 p;
+  for (int lane = 0; lane < kWideLanes; ++lane) {
+    Vec3* t = tri[lane];
+    switch ((i + lane) % 6) {
+      case 0:  // lattice triangles: shared edges and vertices between lanes and packs
+      case 1:
+        t[0] = lattice(), t[1] = lattice(), t[2] = lattice();
+        break;
+      case 2:  // degenerate: repeated vertex, collinear, or a point
+        t[0] = lattice(), t[1] = lattice();
+        t[2] = i % 3 == 0 ? t[0] : i % 3 == 1 ? t[0] + (t[1] - t[0]) * 2.0f : t[0];
+        if (i % 3 == 2) t[1] = t[0];
+        break;
+      case 3:  // a copy of the previous lane (ties in t), or of lane 0 with its edge reversed
+        if (lane > 0) {
+          t[0] = tri[lane - 1][0], t[1] = tri[lane - 1][1], t[2] = tri[lane - 1][2];
+          if (i % 2) std::swap(t[1], t[2]);
+          break;
+        }
+        [[fallthrough]];
+      default:
+        for (int k = 0; k < 3; ++k) t[k] = {u(rng), u(rng), u(rng)};
+    }
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) p.v[k][a][lane] = t[k][a];
+  }
+  return p;
+}
+
+std::uint32_t bits(float f) {
+  return std::bit_cast<std::uint32_t>(f);
+}
+
+TEST(SimdTraversal, TrianglePackKernelMatchesScalarTriangleTest) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::uniform_int_distribution<int> grid(-2, 2);
+  int hits = 0, edge_hits = 0;
+  for (int i = 0; i < 40000; ++i) {
+    Vec3 tri[kWideLanes][3];
+    const TrianglePack4 pack = random_pack(rng, i, tri);
+    Vec3 o{u(rng), u(rng), u(rng)}, d{u(rng), u(rng), u(rng)};
+    if (i % 4 == 0) {  // axis-parallel through lattice points: exactly through edges, vertices
+      const int axis = i / 4 % 3;
+      o = {float(grid(rng)), float(grid(rng)), float(grid(rng))};
+      o[axis] = 3.0f;
+      d = {};
+      d[axis] = i % 8 == 0 ? -1.0f : 1.0f;
+    } else if (i % 4 == 1) {  // aimed at a vertex or an edge's midpoint
+      const Vec3* t = tri[i / 4 % kWideLanes];
+      o = o * 3.0f;
+      d = (i % 8 == 1 ? t[0] : (t[1] + t[2]) * 0.5f) - o;
+    } else if (i % 4 == 2) {  // diagonal through lattice points
+      o = {float(grid(rng)), float(grid(rng)), 3.0f};
+      d = {0.5f * float(grid(rng)), 0.5f * float(grid(rng)), -1.0f};
+    }
+    const float tmin = i % 5 == 0 ? 0.5f : 0.0f, tmax = i % 7 == 0 ? 1.5f : kInfinity;
+    const Ray ray = Ray::make(o, d, tmin, tmax);
+    const TrianglePre pre = TrianglePre::of(ray);
+    const int n = 1 + i % kWideLanes;
+    TrianglePackHits out;
+    const unsigned mask = triangle_test4(pack, WideRay::of(ray), tmin, tmax, n, out);
+    ASSERT_EQ(mask >> n, 0u) << "case " << i << ": lanes beyond n";
+    for (int lane = 0; lane < n; ++lane) {
+      TriangleCandidate h;
+      const bool hit = triangle_test(ray, pre, tri[lane][0], tri[lane][1], tri[lane][2], h);
+      ASSERT_EQ(((mask >> lane) & 1u) != 0, hit) << "case " << i << " lane " << lane;
+      if (!hit) continue;
+      ++hits;
+      edge_hits += h.u == 0.0f || h.v == 0.0f || h.w == 0.0f;
+      const TriangleCandidate c = out.lane(lane);
+      EXPECT_EQ(bits(c.t), bits(h.t)) << "case " << i << " lane " << lane;
+      EXPECT_EQ(bits(c.u), bits(h.u)) << "case " << i << " lane " << lane;
+      EXPECT_EQ(bits(c.v), bits(h.v)) << "case " << i << " lane " << lane;
+      EXPECT_EQ(bits(c.w), bits(h.w)) << "case " << i << " lane " << lane;
+      EXPECT_EQ(bits(c.det), bits(h.det)) << "case " << i << " lane " << lane;
+    }
+  }
+  EXPECT_GT(hits, 5000);
+  EXPECT_GT(edge_hits, 500) << "rays through edges and vertices must be covered";
+}
+
+/// Triangle-only leaves of several packs (leaf sizes 5..9), duplicated triangles (ties in t
+/// inside a leaf and across its packs) and rays along lattice lines through shared edges and
+/// vertices: the pack path's closest-hit choice and counts against the reference.
+TEST(SimdTraversal, TriangleLeavesMatchReference) {
+  std::vector<Primitive> prims;
+  for (int x = 0; x < 8; ++x)
+    for (int y = 0; y < 8; ++y)
+      for (int z = 0; z < 3; ++z) {
+        const Vec3 p{float(x), float(y), float(2 * z)};
+        prims.push_back(Primitive::triangle(p, p + Vec3{1, 0, 0}, p + Vec3{0, 1, 0}));
+        prims.push_back(
+            Primitive::triangle(p + Vec3{1, 0, 0}, p + Vec3{1, 1, 0}, p + Vec3{0, 1, 0}));
+        if ((x + y + z) % 3 == 0) prims.push_back(prims.back());  // an exact duplicate
+        if ((x + y) % 4 == 1) prims.push_back(Primitive::triangle(p, p, p + Vec3{1, 1, 0}));
+      }
+  const Bbox box = Bbox::of({0, 0, 0}, {8, 8, 5});
+  std::vector<Ray> rays = random_rays(box, 600, 23);
+  std::mt19937 rng(29);
+  std::uniform_int_distribution<int> grid(0, 8);
+  for (int i = 0; i < 600; ++i) {  // through lattice points: shared edges and vertices
+    const Vec3 o{0.5f * float(grid(rng)), 0.5f * float(grid(rng)), 7.0f};
+    rays.push_back(Ray::make(o, i % 2 ? Vec3{0, 0, -1} : Vec3{0.5f, 0.25f, -1.0f}));
+  }
+  for (int leaf : {5, 8, 9}) {
+    BuildConfig bc;
+    bc.arity = 4;
+    bc.leaf_size = leaf;
+    bc.parallel = false;
+    const ExplicitHierarchy h = build_explicit(prims, {Surface{}}, bc);
+    ASSERT_NE(h.wide_nodes(), nullptr);
+    int multi_pack = 0;  // leaves of more than one pack
+    for (const WideHeader& hd : h.wide.headers)
+      multi_pack += hd.leaf == kWideTriangleLeaf && hd.count > kWideLanes;
+    ASSERT_GT(multi_pack, 0) << "leaf size " << leaf;
+    compare_all(h, rays, h.levels, "lattice leaf " + std::to_string(leaf));
   }
 }
 

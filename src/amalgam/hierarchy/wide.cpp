@@ -1,6 +1,12 @@
 #include "amalgam/hierarchy/wide.h"
 
+#include <limits>
+
 #include "amalgam/hierarchy/explicit.h"
+
+namespace {
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+}  // namespace
 
 namespace amalgam {
 
@@ -8,18 +14,40 @@ void build_wide(ExplicitHierarchy& h) {
   WideNodes& w = h.wide;
   w.headers.assign(h.nodes.size(), WideHeader{});
   w.blocks.clear();
-  std::size_t n_blocks = 0;
+  w.tris.clear();
+  std::size_t n_blocks = 0, n_packs = 0;
   for (const ExplicitNode& n : h.nodes)
-    if (!n.leaf) n_blocks += (n.count + kWideLanes - 1) / kWideLanes;
+    (n.leaf ? n_packs : n_blocks) += (n.count + kWideLanes - 1) / kWideLanes;
   w.blocks.reserve(n_blocks);
+  w.tris.reserve(n_packs);  // an upper bound: leaves with spheres or boxes take none
   for (std::size_t i = 0; i < h.nodes.size(); ++i) {
     const ExplicitNode& n = h.nodes[i];
     WideHeader& hd = w.headers[i];
     hd.first = n.first;
     hd.count = n.count;
-    hd.leaf = n.leaf ? 1 : 0;
+    hd.leaf = n.leaf ? kWideLeaf : kWideInterior;
     hd.block = static_cast<std::uint32_t>(w.blocks.size());
-    if (n.leaf) continue;
+    if (n.leaf) {
+      bool triangles = n.count > 0;
+      for (int j = 0; j < n.count; ++j)
+        triangles = triangles && h.prims[n.first + j].kind == PrimKind::kTriangle;
+      if (!triangles) continue;  // spheres and boxes: the scalar loop over `prims`
+      hd.leaf = kWideTriangleLeaf;
+      hd.block = static_cast<std::uint32_t>(w.tris.size());
+      for (int c0 = 0; c0 < n.count; c0 += kWideLanes) {
+        TrianglePack4 pack;
+        for (int lane = 0; lane < kWideLanes; ++lane) {
+          const int c = c0 + lane;
+          for (int k = 0; k < 3; ++k) {
+            const Primitive* p = c < n.count ? &h.prims[n.first + c] : nullptr;
+            const Vec3 vtx = !p ? Vec3{kNaN, kNaN, kNaN} : k == 0 ? p->a : k == 1 ? p->b : p->c;
+            for (int a = 0; a < 3; ++a) pack.v[k][a][lane] = vtx[a];
+          }
+        }
+        w.tris.push_back(pack);
+      }
+      continue;
+    }
     for (int c0 = 0; c0 < n.count; c0 += kWideLanes) {
       WideBox4 b;
       for (int lane = 0; lane < kWideLanes; ++lane) {

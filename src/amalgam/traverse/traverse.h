@@ -23,9 +23,11 @@
 /// watertight triangle setup is done once and a primitive hit's SurfaceHit is built only for
 /// the final closest hit. A hierarchy that exposes `wide_nodes()` (ExplicitHierarchy, see
 /// hierarchy/wide.h) and `prims` gets, in sorted order, an iterative traversal with an
-/// explicit stack that tests all children of a node at once with SIMD. The scalar reference,
-/// the original recursive traversal, is ReferenceTraversal (reference.h); the two give the
-/// same hits and the same counts (tests/traverse/simd_test.cpp).
+/// explicit stack that tests all children of a node at once with SIMD, and the triangles of a
+/// triangle-only leaf four at a time from SoA packs (same results and counts as testing them
+/// one by one). The scalar reference, the original recursive traversal, is
+/// ReferenceTraversal (reference.h); the two give the same hits and the same counts
+/// (tests/traverse/simd_test.cpp).
 
 #include <algorithm>
 #include <bit>
@@ -192,18 +194,38 @@ class Traversal {
     }
   }
 
+  struct StackItem {
+    float t;
+    std::uint32_t node;
+    int level;
+  };
+
   /// The fast path: sorted order over SoA child boxes, iterative with an explicit stack.
   /// Pushing a node's hit children farthest-first makes the pops the same depth-first,
   /// nearest-first order as the recursion in `visit`; a popped entry beyond the closest hit
-  /// is skipped, as `visit` breaks there (every later sibling is farther still).
+  /// is skipped, as `visit` breaks there (every later sibling is farther still). The stack is
+  /// `stack_[0, sp)`, grown before a node's children are pushed (not per push).
   void run_wide(const WideNodes& w, std::uint32_t root, float t_root) {
-    tri_ = TrianglePre::of(ray_);
-    wray_ = WideRay::of(ray_);
-    stack_.clear();
-    stack_.push_back({t_root, root, 0});
-    while (!stack_.empty() && !done_) {
-      const StackItem it = stack_.back();
-      stack_.pop_back();
+    if (stack_.size() < 64) stack_.resize(64);
+    stack_[0] = {t_root, root, 0};
+    // A ray with a zero direction component needs the box test's containment branch per
+    // axis; all others (nearly every ray) run a loop without those branches.
+    if (ray_.dir.x == 0.0f || ray_.dir.y == 0.0f || ray_.dir.z == 0.0f)
+      wide_loop<true>(w);
+    else
+      wide_loop<false>(w);
+  }
+
+  template <bool kZeroAxes>
+  void wide_loop(const WideNodes& w) {
+    // The per-ray constants and the stack's base and capacity as locals: members would be
+    // reloaded after every store to the stack (a float store may alias them).
+    const WideRay wr = WideRay::of(ray_);
+    tri_ = wr.pre;  // for the primitives of mixed leaves (`primitive_wide`)
+    StackItem* s = stack_.data();
+    std::size_t cap = stack_.size(), sp = 1;
+    while (sp > 0 && !done_) {
+      const StackItem it = s[--sp];
       if (it.t > ray_.tmax) continue;
       if constexpr (kMayRender) {
         if (lod_.may_render(it.level)) {
@@ -214,14 +236,25 @@ class Traversal {
           }
         }
       }
-      expand_wide(w, it.node, it.level);
+      expand_wide<kZeroAxes>(w, wr, it.node, it.level, s, cap, sp);
     }
   }
 
-  void expand_wide(const WideNodes& w, std::uint32_t node, int level) {
+  /// Always inlined into the pop loop of `wide_loop`: as a call per node it cost register
+  /// saves and restores and the box kernel's per-ray constants were set up again for every
+  /// node (inlining it, with the pushes straight onto the stack below, took the engine primary
+  /// rays from 2 578 to 2 133 instructions per ray; docs/benchmarks.md).
+  template <bool kZeroAxes>
+  [[gnu::always_inline]] void expand_wide(const WideNodes& w, const WideRay& wr, std::uint32_t node,
+                                          int level, StackItem*& s, std::size_t& cap,
+                                          std::size_t& sp) {
     const WideHeader hd = w.headers[node];
     const int cl = level + 1;
     const int count = hd.count;
+    if (hd.leaf == kWideTriangleLeaf) {
+      leaf_triangles(w, wr, hd, cl);
+      return;
+    }
     if (hd.leaf) {
       for (int i = 0; i < count; ++i) {
         counters_.count_test(kind_, ObjectKind::kPrimitive, cl);
@@ -232,16 +265,22 @@ class Traversal {
     }
     const ObjectKind ok = object_kind(cl);
     for (int i = 0; i < count; ++i) counters_.count_test(kind_, ok, cl);
-    StackItem hits[kMaxChildren];
-    int n = 0;
+    if (sp + count > cap) {
+      stack_.resize(2 * cap + count);
+      s = stack_.data(), cap = stack_.size();
+    }
+    // The hit children go straight onto the stack, insertion-sorted farthest first (the
+    // nearest is popped first). A later child (stored order) goes below the hits with equal
+    // t, so that among equals the first in stored order is popped first, as the recursion
+    // enters them (stable sort).
+    const std::size_t base = sp;
     auto collect = [&](unsigned mask, const float* t, int c0) {
-      while (mask) {
+      for (; mask; mask &= mask - 1) {
         const int lane = std::countr_zero(mask);
-        mask &= mask - 1;
-        const float te = t[lane];
-        int i = n++;  // insertion sort, stable for equal t (lanes come in stored order)
-        while (i > 0 && hits[i - 1].t > te) hits[i] = hits[i - 1], --i;
-        hits[i] = {te, hd.first + static_cast<std::uint32_t>(c0 + lane), cl};
+        const float te = t[lane];  // never NaN: a NaN entry fails the kernel's t0 <= t1
+        std::size_t i = sp++;
+        while (i > base && s[i - 1].t <= te) s[i] = s[i - 1], --i;
+        s[i] = {te, hd.first + static_cast<std::uint32_t>(c0 + lane), cl};
       }
     };
     const WideBox4* blk = w.blocks.data() + hd.block;
@@ -250,15 +289,49 @@ class Traversal {
     for (; count - c0 > kWideLanes; c0 += 2 * kWideLanes, blk += 2) {
       alignas(32) float t[2 * kWideLanes];
       const int m = std::min(count - c0, 2 * kWideLanes);
-      collect(intersect_wide8(blk[0], blk[1], wray_, ray_.tmin, ray_.tmax, m, t), t, c0);
+      collect(intersect_wide8<kZeroAxes>(blk[0], blk[1], wr, ray_.tmin, ray_.tmax, m, t), t, c0);
     }
 #endif
     for (; c0 < count; c0 += kWideLanes, ++blk) {
       alignas(16) float t[kWideLanes];
       const int m = std::min(count - c0, kWideLanes);
-      collect(intersect_wide4(*blk, wray_, ray_.tmin, ray_.tmax, m, t), t, c0);
+      collect(intersect_wide4<kZeroAxes>(*blk, wr, ray_.tmin, ray_.tmax, m, t), t, c0);
     }
-    for (int i = n; i-- > 0;) stack_.push_back(hits[i]);
+  }
+
+  /// A triangle-only leaf, four triangles at a time (`triangle_test4`), with the results and
+  /// counts of the one-by-one loop in `expand_wide`: there, a triangle is tested against the
+  /// tmax left by the hits before it, so of the lanes hit (all tested against the same tmax)
+  /// a lane is taken in leaf order when its t is still <= tmax (ties: the later one, as
+  /// there); a shadow ray stops at the first hit in leaf order, having tested the triangles
+  /// up to and including it.
+  void leaf_triangles(const WideNodes& w, const WideRay& wr, const WideHeader& hd, int level) {
+    const TrianglePack4* pack = w.tris.data() + hd.block;
+    const int count = hd.count;
+    for (int c0 = 0; c0 < count; c0 += kWideLanes, ++pack) {
+      const int m = std::min(count - c0, kWideLanes);
+      TrianglePackHits c;
+      unsigned mask = triangle_test4(*pack, wr, ray_.tmin, ray_.tmax, m, c);
+      if (any_hit_ && mask) {
+        const int tested = std::countr_zero(mask) + 1;
+        for (int i = 0; i < tested; ++i) counters_.count_test(kind_, ObjectKind::kPrimitive, level);
+        transmittance_ = 0.0f;
+        done_ = true;
+        return;
+      }
+      for (int i = 0; i < m; ++i) counters_.count_test(kind_, ObjectKind::kPrimitive, level);
+      for (; mask; mask &= mask - 1) {
+        const int lane = std::countr_zero(mask);
+        if (!(c.t[lane] <= ray_.tmax)) continue;  // an earlier lane hit closer
+        ray_.tmax = c.t[lane];
+        hit_.kind = TraceHit::Kind::kPrimitive;
+        hit_.t = c.t[lane];
+        hit_.id = hd.first + static_cast<std::uint32_t>(c0 + lane);
+        hit_.level = level;
+        pending_ = true;
+        cand_ = c.lane(lane);
+      }
+    }
   }
 
   /// One primitive test on the fast path: triangles with the per-ray setup and a deferred
@@ -333,12 +406,6 @@ class Traversal {
     hit_ = TraceHit{TraceHit::Kind::kAmalgam, t, id, level, box_entry_hit(ray_, b, t)};
   }
 
-  struct StackItem {
-    float t;
-    std::uint32_t node;
-    int level;
-  };
-
   const H& h_;
   Lod lod_;
   Stats& counters_;
@@ -354,7 +421,6 @@ class Traversal {
   bool pending_ = false;  ///< hit_ is a triangle whose SurfaceHit is not built yet
   TriangleCandidate cand_{};
   TrianglePre tri_{};
-  WideRay wray_{};
   std::vector<StackItem> stack_;
 };
 
