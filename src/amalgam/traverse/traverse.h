@@ -32,6 +32,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "amalgam/hierarchy/bake.h"
 #include "amalgam/hierarchy/hierarchy.h"
 #include "amalgam/hierarchy/wide.h"
 #include "amalgam/math/random.h"
@@ -322,7 +323,8 @@ class Traversal {
   }
 
   void render(NodeId id, int level, const Bbox& b, float t) {
-    const float a = h_.appearance(id).opacity;
+    // The probability that this ray, in its direction, meets the contents (bake.h).
+    const float a = directional_opacity(h_.appearance(id), b, ray_.dir);
     bool opaque;
     if constexpr (kOpacity == OpacityModel::kStochastic) {
       opaque = to_unit_float(hash_combine(key_, id)) < a;
@@ -392,7 +394,7 @@ class Traversal {
     NodeId ids[kMaxChildren];
     int count;
     if (slot == 0) {
-      const ExplicitNode& t = h_.top_nodes[node];
+      const auto& t = h_.top_nodes[node];
       count = static_cast<int>(t.count);
       for (int i = 0; i < count; ++i) {
         const Bbox* b;
@@ -409,7 +411,7 @@ class Traversal {
     } else {
       const auto& in = h_.instances[slot - 1];
       const auto& mesh = h_.meshes[in.mesh];
-      const ExplicitNode& e = mesh.nodes[H::local(node)];
+      const auto& e = mesh.nodes[H::local(node)];
       count = static_cast<int>(e.count);
       if (e.leaf) {
         for (int i = 0; i < count; ++i) {
