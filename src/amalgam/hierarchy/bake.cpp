@@ -1,8 +1,13 @@
 #include "amalgam/hierarchy/bake.h"
 
+#include <oneapi/tbb/parallel_reduce.h>
+#include <oneapi/tbb/parallel_sort.h>
+
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "amalgam/hierarchy/hierarchy.h"
 #include "amalgam/math/random.h"
@@ -78,6 +83,72 @@ Ray sample_line(const Bbox& box, const float u[6]) {
   return Ray::make(p - d * reach, d);
 }
 
+float directional_opacity(const Appearance& app, const Bbox& box, Vec3 dir) {
+  const float a = app.opacity;
+  if (app.shading == Shading::kFace || !(a > 0.0f)) return a;
+  const float len = length(dir);
+  if (!(len > 0.0f)) return a;
+  const Vec3 d = dir / len;
+  if (app.shading == Shading::kOriented && dot(app.normal, d) > 0.0f) return 0.0f;  // behind
+  const Vec3 e = box.extent();
+  const float quarter = 0.5f * (e.y * e.z + e.z * e.x + e.x * e.y);  // S(box) / 4
+  const float proj =
+      e.y * e.z * std::fabs(d.x) + e.z * e.x * std::fabs(d.y) + e.x * e.y * std::fabs(d.z);
+  if (!(quarter > 0.0f) || !(proj > 0.0f)) return a;  // degenerate box: no better estimate
+  const float contents =
+      app.shading == Shading::kCloud ? 1.0f : 2.0f * std::fabs(dot(app.normal, d));
+  return std::clamp(a * contents * quarter / proj, 0.0f, 1.0f);
+}
+
+int closed_orientation(std::span<const Primitive> prims) {
+  // A directed edge a->b as a 64-bit hash of the bits of its end points (collisions: about
+  // n^2 / 2^65, negligible below 10^8). Consistently wound: no directed edge occurs twice.
+  // Closed up to small holes: at least 95 % of the directed edges have their reverse (real
+  // meshes have some: Wuson.ply's eyes and seams leave 412 of its 11,196 edges unmatched).
+  auto key = [](Vec3 p) {
+    return hash_combine(hash_combine(hash_combine(0x0e1d6e5, std::bit_cast<std::uint32_t>(p.x)),
+                                     std::bit_cast<std::uint32_t>(p.y)),
+                        std::bit_cast<std::uint32_t>(p.z));
+  };
+  std::vector<std::uint64_t> fwd, rev;
+  double volume = 0.0;  // six times the enclosed signed volume
+  for (const Primitive& t : prims) {
+    if (t.kind != PrimKind::kTriangle) continue;
+    const std::uint64_t k[3] = {key(t.a), key(t.b), key(t.c)};
+    for (int i = 0; i < 3; ++i) {
+      fwd.push_back(hash_combine(k[i], k[(i + 1) % 3]));
+      rev.push_back(hash_combine(k[(i + 1) % 3], k[i]));
+    }
+    const Vec3 c = cross(t.b, t.c);
+    volume += static_cast<double>(t.a.x) * c.x + static_cast<double>(t.a.y) * c.y +
+              static_cast<double>(t.a.z) * c.z;
+  }
+  if (fwd.empty()) return 0;
+  tbb::parallel_sort(fwd.begin(), fwd.end());
+  tbb::parallel_sort(rev.begin(), rev.end());
+  if (std::adjacent_find(fwd.begin(), fwd.end()) != fwd.end()) return 0;
+  std::size_t matched = 0;
+  for (auto f = fwd.begin(), r = rev.begin(); f != fwd.end() && r != rev.end();) {
+    if (*f < *r) {
+      ++f;
+    } else if (*r < *f) {
+      ++r;
+    } else {
+      ++matched, ++f, ++r;
+    }
+  }
+  if (matched * 20 < fwd.size() * 19) return 0;
+  return volume > 0.0 ? 1 : volume < 0.0 ? -1 : 0;
+}
+
+void orient(BakeResult& r, Vec3 outward, float weight) {
+  if (r.app.shading != Shading::kNormal || !(weight > 0.0f)) return;
+  const float along = dot(outward, r.app.normal) / weight;
+  if (!(std::fabs(along) >= 0.5f)) return;
+  if (along < 0.0f) r.app.normal = -r.app.normal;
+  r.app.shading = Shading::kOriented;
+}
+
 BakeResult finish_bake(int rays, int hits, Vec3 colour, float spec, float shine,
                        NormalTensor normals) {
   BakeResult r;
@@ -106,6 +177,8 @@ BakeResult bake_from_children(const Bbox& box, std::span<const BakeChild> kids, 
   Vec3 colour{};
   float spec = 0.0f, shine = 0.0f, weight = 0.0f, opacity = 0.0f;
   NormalTensor normals;
+  Vec3 outward{};
+  bool oriented = true;  // every child seen has an outward normal
   rays = std::max(rays, 1);
   for (int r = 0; r < rays; ++r) {
     Sampler s(hash_combine(key, static_cast<std::uint64_t>(r)));
@@ -131,6 +204,10 @@ BakeResult bake_from_children(const Bbox& box, std::span<const BakeChild> kids, 
       spec += c.app.surface.reflectance * w;
       shine += c.app.surface.shininess * w;
       normals.add(c.normals, w);
+      if (c.app.shading == Shading::kOriented)
+        outward += c.app.normal * w;
+      else
+        oriented = false;
       weight += w;
       through *= 1.0f - a;
     }
@@ -148,6 +225,7 @@ BakeResult bake_from_children(const Bbox& box, std::span<const BakeChild> kids, 
     out.normals = normals;
     out.app.normal = dominant_normal(normals);
     out.app.shading = out.app.normal == Vec3{} ? Shading::kCloud : Shading::kNormal;
+    if (oriented) orient(out, outward, weight);
   }
   return out;
 }

@@ -29,7 +29,19 @@ struct BakeConfig {
                          ///< exactly against their subtree; larger ones combine children
   bool parallel = true;  ///< oneTBB over the nodes of one level
   std::uint64_t seed = 0x6a6b;
+  /// Flat amalgams get an outward normal (Shading::kOriented) when the hierarchy's triangles
+  /// form closed, consistently wound surfaces (closed_orientation); the check is skipped for
+  /// more triangles than this (it sorts two 8-byte keys per edge).
+  std::uint64_t orient_max_triangles = std::uint64_t{1} << 24;
 };
+
+/// Whether `prims`' triangles form closed, consistently wound surfaces: +1 when no directed
+/// edge a->b (vertices compared bit for bit) occurs twice, at least 95 % of them are matched by
+/// a b->a (closed up to small holes, as real meshes are) and the enclosed signed volume is
+/// positive (wound counter-clockwise seen from outside), -1 for the same wound inward, 0
+/// otherwise (open, inconsistent, no triangles). Other primitive kinds are ignored (spheres
+/// and boxes are closed solids of their own).
+int closed_orientation(std::span<const Primitive> prims);
 
 /// Symmetric 3x3 tensor sum w n n^T, stored xx, yy, zz, xy, yz, zx.
 struct NormalTensor {
@@ -65,6 +77,26 @@ NormalTensor transform_tensor(const NormalTensor& t, const Vec3 rows[3]);
 /// six uniform numbers in [0, 1); u[0] picks the face (stratify it), u[1] the side.
 Ray sample_line(const Bbox& box, const float u[6]);
 
+/// Opacity of a rendered amalgam for rays of direction `dir` (any length), i.e. the
+/// probability that a line of that direction crossing `box` hits the contents.
+/// `Appearance::opacity` is the mean of that probability over all lines crossing the box (the
+/// isotropic line measure); by Cauchy's formula it is E[A_c(d)] / E[A_box(d)], A(d) the area
+/// projected along d. The box's projected area is known exactly (E[A_box] = S(box) / 4), and
+/// the contents' follows from how the bake classified them: a flat layer (`Shading::kNormal`,
+/// normal n) projects A |n . d| (mean A / 2), a cloud of isotropically oriented facets
+/// (`Shading::kCloud`) the same area in every direction. Hence
+///   a(d) = a * F_c(d) / F_box(d),  F_box(d) = A_box(d) / (S / 4),  F_c = 2 |n . d| or 1,
+/// clamped to [0, 1]. Its mean over isotropic lines crossing the box is `a` again.
+/// A flat patch of a closed surface is nearly opaque to the rays that see it face on (the
+/// rays that matter: the visible surface is seen along its normal) while the isotropic mean is
+/// about 1/3; with the isotropic value those rays leak through the front of an object to
+/// patches behind it (docs/real-scenes.md, "the far band"). A `Shading::kOriented` patch is
+/// also transparent (0) to a ray meeting it from behind: an unstopped ray is outside every
+/// closed surface, so a back face is never the first thing it meets. `Shading::kFace`
+/// appearances (hand-made, the builtin scenes) keep `a` in every direction. The traversal's
+/// `render` (traverse.h, reference.h) calls this with the ray's direction.
+float directional_opacity(const Appearance& app, const Bbox& box, Vec3 dir);
+
 /// A child of a node being baked, as the parent sees it.
 struct BakeChild {
   Bbox bounds;
@@ -77,6 +109,11 @@ struct BakeResult {
   Appearance app;
   NormalTensor normals;
 };
+
+/// Turns a kNormal result into kOriented when the outward normals met while baking agree on a
+/// side: `outward` is their (weighted) sum, `weight` the sum of weights; the normal is flipped
+/// to point out when the mean outward normal's component along it is at least 1/2 in size.
+void orient(BakeResult& r, Vec3 outward, float weight);
 
 /// Bakes a node from its children's appearances: `rays` random lines through `box`, each
 /// meeting the children it crosses front to back, child i stopping it with probability

@@ -49,12 +49,17 @@ ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surfa
 namespace {
 
 /// Exact bake of node `id`: random lines traced (closest hit) against its subtree.
-BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeConfig& cfg) {
+/// `orientation`: closed_orientation of the hierarchy's primitives (0: triangles have no
+/// known outside, so the result is never kOriented when one is hit).
+BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeConfig& cfg,
+                      int orientation) {
   const int rays = std::max(cfg.rays, 1);
   const Bbox box = h.nodes[id].bounds;
   Vec3 colour{};
   float spec = 0.0f, shine = 0.0f;
   NormalTensor normals;
+  Vec3 outward{};  // sum of the outward normals at the hits
+  bool oriented = true;
   int hits = 0;
   std::vector<std::uint32_t> stack;
   for (int r = 0; r < rays; ++r) {
@@ -96,14 +101,28 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
     spec += m.reflectance;
     shine += m.shininess;
     normals.add(best->normal, 1.0f);
+    const Primitive& bp = h.prims[best_prim];
+    if (bp.kind != PrimKind::kTriangle) {
+      outward += best->normal;  // facing the line, which comes from outside the solid
+    } else if (orientation != 0) {
+      const Vec3 w = cross(bp.b - bp.a, bp.c - bp.a);
+      const float len = length(w);
+      if (len > 0.0f) outward += w * (static_cast<float>(orientation) / len);
+    } else {
+      oriented = false;
+    }
   }
-  return finish_bake(rays, hits, colour, spec, shine, normals);
+  BakeResult r = finish_bake(rays, hits, colour, spec, shine, normals);
+  if (oriented) orient(r, outward, static_cast<float>(hits));
+  return r;
 }
 
 }  // namespace
 
 void bake(ExplicitHierarchy& h, const BakeConfig& config) {
   const std::size_t n = h.nodes.size();
+  const int orientation =
+      h.prims.size() <= config.orient_max_triangles ? closed_orientation(h.prims) : 0;
   h.appearances.assign(n, Appearance{});
   std::vector<NormalTensor> tensors(n);
   std::vector<std::uint64_t> prims_below(n, 0);
@@ -125,7 +144,7 @@ void bake(ExplicitHierarchy& h, const BakeConfig& config) {
     const ExplicitNode& node = h.nodes[i];
     BakeResult r;
     if (node.leaf || prims_below[i] <= static_cast<std::uint64_t>(config.exact_prims)) {
-      r = bake_exact(h, static_cast<std::uint32_t>(i), config);
+      r = bake_exact(h, static_cast<std::uint32_t>(i), config, orientation);
     } else {
       BakeChild kids[kMaxChildren];
       const int k = std::min<int>(node.count, kMaxChildren);

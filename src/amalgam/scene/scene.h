@@ -29,6 +29,11 @@ enum class Shading : std::uint8_t {
   /// A cloud of isotropically oriented Lambertian facets (the Lambert-sphere phase function):
   /// baked contents that are not predominantly flat, e.g. a whole mesh seen from far away.
   kCloud,
+  /// As kNormal, with `Appearance::normal` pointing out of the closed surfaces the contents
+  /// are part of: a ray meeting it from behind (dot(normal, dir) > 0) comes from inside, and
+  /// a ray that has not stopped yet is outside every object, so it passes (opacity 0 for it;
+  /// see directional_opacity in hierarchy/bake.h).
+  kOriented,
 };
 
 /// The visual attributes of an amalgam: a surface, an opacity, optionally a shading normal

@@ -125,7 +125,8 @@ class ReferenceTraversal {
   }
 
   void render(NodeId id, int level, const Bbox& b, float t) {
-    const float a = h_.appearance(id).opacity;
+    // The probability that this ray, in its direction, meets the contents (bake.h).
+    const float a = directional_opacity(h_.appearance(id), b, ray_.dir);
     bool opaque;
     if constexpr (kOpacity == OpacityModel::kStochastic) {
       opaque = to_unit_float(hash_combine(key_, id)) < a;

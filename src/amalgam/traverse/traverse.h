@@ -34,6 +34,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "amalgam/hierarchy/bake.h"
 #include "amalgam/hierarchy/hierarchy.h"
 #include "amalgam/hierarchy/wide.h"
 #include "amalgam/math/random.h"
@@ -69,6 +70,17 @@ template <class H>
 concept WideHierarchy = requires(const H& h, std::size_t i) {
   { h.wide_nodes() } -> std::same_as<const WideNodes*>;
   { h.prims[i] } -> std::convertible_to<const Primitive&>;
+};
+
+/// The two-level instanced hierarchy (hierarchy/instanced.h), detected by its members: the
+/// traversal's instanced fast path.
+template <class H>
+concept InstancedTwoLevel = requires(const H& h, std::size_t i) {
+  h.top_nodes[i];
+  h.top_items[i];
+  h.instances[i].world_bounds;
+  h.meshes[i].nodes[i].bounds;
+  H::world_box(h.instances[i], h.meshes[i].nodes[i].bounds);
 };
 
 /// `Stats` is Counters (exact counts) or NullCounters (counting compiled out, to measure the
@@ -107,6 +119,7 @@ class Traversal {
   /// after a node's own test).
   static constexpr bool kMayRender = !std::is_same_v<Lod, TraditionalLod>;
   static constexpr bool kWide = WideHierarchy<H> && kSorted;
+  static constexpr bool kInstancedFast = InstancedTwoLevel<H> && kSorted;
 
   void start(const Ray& ray, std::uint64_t key, RayKind kind, bool any_hit) {
     ray_ = ray;
@@ -131,6 +144,10 @@ class Traversal {
         run_wide(*w, static_cast<std::uint32_t>(root), t0);
         return;
       }
+    }
+    if constexpr (kInstancedFast) {
+      run_instanced(root, t0);
+      return;
     }
     enter(root, 0, b, t0);
   }
@@ -379,7 +396,8 @@ class Traversal {
   }
 
   void render(NodeId id, int level, const Bbox& b, float t) {
-    const float a = h_.appearance(id).opacity;
+    // The probability that this ray, in its direction, meets the contents (bake.h).
+    const float a = directional_opacity(h_.appearance(id), b, ray_.dir);
     bool opaque;
     if constexpr (kOpacity == OpacityModel::kStochastic) {
       opaque = to_unit_float(hash_combine(key_, id)) < a;
@@ -406,6 +424,171 @@ class Traversal {
     hit_ = TraceHit{TraceHit::Kind::kAmalgam, t, id, level, box_entry_hit(ray_, b, t)};
   }
 
+  /// The instanced fast path (sorted order): iterative like run_wide, the children of a node
+  /// tested four at a time with the SIMD slab kernel. Their boxes are gathered: top-level
+  /// nodes' and instance roots' world boxes as stored, and, inside an instance, the world box
+  /// of each child's transformed box computed four at a time (`world_boxes4`) with the float
+  /// operations of InstancedHierarchy::world_box in the same order, so that every test, count
+  /// and order is the generic path's (tests/traverse/simd_test.cpp compares them).
+  ///
+  /// The LOD decision (render or descend) depends only on the box, the level, the entry t and
+  /// the ray's cone, none of which change while the ray is traced, so it is taken when a
+  /// child is pushed, with its box at hand, instead of recomputing the world box when popped.
+  void run_instanced(NodeId root, float t_root) {
+    const WideRay wr = WideRay::of(ray_);
+    istack_.clear();
+    istack_.push_back({t_root, 0, decide(h_.bounds(root), 0, t_root), root});
+    while (!istack_.empty() && !done_) {
+      const InstItem it = istack_.back();
+      istack_.pop_back();
+      if (it.t > ray_.tmax) continue;
+      if constexpr (kMayRender) {
+        if (it.render) {
+          render(it.node, it.level, h_.bounds(it.node), it.t);
+          continue;
+        }
+      }
+      expand_instanced(wr, it.node, it.level);
+    }
+  }
+
+  bool decide(const Bbox& b, int level, float t) const {
+    if constexpr (kMayRender) {
+      return lod_.may_render(level) &&
+             lod_.render(b, level, ray_, t, t <= ray_.tmin && b.contains(ray_.origin));
+    }
+    return false;
+  }
+
+  void expand_instanced(const WideRay& wr, NodeId node, int level) {
+    const int cl = level + 1;
+    const std::uint64_t slot = H::slot(node);
+    WideBox4 blk[kMaxChildren / kWideLanes + 1];
+    NodeId ids[kMaxChildren];
+    int count;
+    if (slot == 0) {
+      const auto& t = h_.top_nodes[node];
+      count = static_cast<int>(t.count);
+      for (int i = 0; i < count; ++i) {
+        const Bbox* b;
+        if (t.leaf) {
+          const std::uint32_t inst = h_.top_items[t.first + i];
+          ids[i] = H::id(inst + 1ull, 0);
+          b = &h_.instances[inst].world_bounds;
+        } else {
+          ids[i] = t.first + static_cast<std::uint32_t>(i);
+          b = &h_.top_nodes[t.first + i].bounds;
+        }
+        put_box(blk, i, *b);
+      }
+    } else {
+      const auto& in = h_.instances[slot - 1];
+      const auto& mesh = h_.meshes[in.mesh];
+      const auto& e = mesh.nodes[H::local(node)];
+      count = static_cast<int>(e.count);
+      if (e.leaf) {
+        for (int i = 0; i < count; ++i) {
+          counters_.count_test(kind_, ObjectKind::kPrimitive, cl);
+          const PrimId p = H::id(slot, e.first + static_cast<std::uint32_t>(i));
+          if (auto s = h_.intersect(p, ray_)) on_primitive(p, cl, *s);
+          if (done_) return;
+        }
+        return;
+      }
+      for (int i = 0; i < count; ++i) {
+        ids[i] = H::id(slot, e.first + static_cast<std::uint32_t>(i));
+        put_box(blk, i, mesh.nodes[e.first + i].bounds);
+      }
+      if (!in.identity) {
+        for (int c0 = 0; c0 < count; c0 += kWideLanes)
+          world_boxes4(in, blk[c0 / kWideLanes], std::min(count - c0, kWideLanes));
+      }
+    }
+    const ObjectKind ok = object_kind(cl);
+    for (int i = 0; i < count; ++i) counters_.count_test(kind_, ok, cl);
+    const bool may_render = kMayRender && lod_.may_render(cl);
+    InstItem hits[kMaxChildren];
+    int n = 0;
+    for (int c0 = 0; c0 < count; c0 += kWideLanes) {
+      alignas(16) float t[kWideLanes];
+      unsigned mask = intersect_wide4(blk[c0 / kWideLanes], wr, ray_.tmin, ray_.tmax,
+                                      std::min(count - c0, kWideLanes), t);
+      while (mask) {
+        const int lane = std::countr_zero(mask);
+        mask &= mask - 1;
+        const float te = t[lane];
+        int i = n++;  // insertion sort, stable for equal t (lanes come in stored order)
+        while (i > 0 && hits[i - 1].t > te) hits[i] = hits[i - 1], --i;
+        const WideBox4& w = blk[c0 / kWideLanes];
+        const bool r = may_render && decide(Bbox{{w.lo[0][lane], w.lo[1][lane], w.lo[2][lane]},
+                                                 {w.hi[0][lane], w.hi[1][lane], w.hi[2][lane]}},
+                                            cl, te);
+        hits[i] = {te, static_cast<std::int16_t>(cl), r, ids[c0 + lane]};
+      }
+    }
+    for (int i = n; i-- > 0;) istack_.push_back(hits[i]);
+  }
+
+  static void put_box(WideBox4* blk, int i, const Bbox& b) {
+    WideBox4& w = blk[i / kWideLanes];
+    const int l = i % kWideLanes;
+    w.lo[0][l] = b.lo.x, w.lo[1][l] = b.lo.y, w.lo[2][l] = b.lo.z;
+    w.hi[0][l] = b.hi.x, w.hi[1][l] = b.hi.y, w.hi[2][l] = b.hi.z;
+  }
+
+  /// Replaces the first `n` object-space boxes of `w` by InstancedHierarchy::world_box of each
+  /// (empty boxes stay as they are, as there).
+  template <class Instance>
+  static void world_boxes4(const Instance& in, WideBox4& w, int n) {
+#if AMALGAM_WIDE_SSE
+    bool any_empty = false;
+    for (int l = 0; l < n; ++l)
+      any_empty |= w.lo[0][l] > w.hi[0][l] || w.lo[1][l] > w.hi[1][l] || w.lo[2][l] > w.hi[2][l];
+    if (!any_empty) {
+      const __m128 half = _mm_set1_ps(0.5f);
+      const __m128 sign = _mm_set1_ps(-0.0f);
+      const __m128 k = _mm_set1_ps(4.0f * gamma(3));
+      __m128 c[3], h[3];
+      for (int a = 0; a < 3; ++a) {
+        const __m128 lo = _mm_load_ps(w.lo[a]), hi = _mm_load_ps(w.hi[a]);
+        c[a] = _mm_mul_ps(_mm_add_ps(lo, hi), half);  // Bbox::center
+        h[a] = _mm_mul_ps(_mm_sub_ps(hi, lo), half);  // Bbox::extent() * 0.5f
+      }
+      for (int r = 0; r < 3; ++r) {
+        const float* m = in.to_world.m[r];
+        // Transform::point: ((m0 x + m1 y) + m2 z) + m3.
+        __m128 cw = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(m[0]), c[0]),
+                                                     _mm_mul_ps(_mm_set1_ps(m[1]), c[1])),
+                                          _mm_mul_ps(_mm_set1_ps(m[2]), c[2])),
+                               _mm_set1_ps(m[3]));
+        // dot(abs_rows[r], h): (x + y) + z.
+        const Vec3 ar = in.abs_rows[r];
+        __m128 rw = _mm_add_ps(
+            _mm_add_ps(_mm_mul_ps(_mm_set1_ps(ar.x), h[0]), _mm_mul_ps(_mm_set1_ps(ar.y), h[1])),
+            _mm_mul_ps(_mm_set1_ps(ar.z), h[2]));
+        // r += (|c| + r) * 4 gamma(3)
+        rw = _mm_add_ps(rw, _mm_mul_ps(_mm_add_ps(_mm_andnot_ps(sign, cw), rw), k));
+        _mm_store_ps(w.lo[r], _mm_sub_ps(cw, rw));
+        _mm_store_ps(w.hi[r], _mm_add_ps(cw, rw));
+      }
+      return;
+    }
+#endif
+    for (int l = 0; l < n; ++l) {
+      const Bbox b = H::world_box(
+          in, Bbox{{w.lo[0][l], w.lo[1][l], w.lo[2][l]}, {w.hi[0][l], w.hi[1][l], w.hi[2][l]}});
+      w.lo[0][l] = b.lo.x, w.lo[1][l] = b.lo.y, w.lo[2][l] = b.lo.z;
+      w.hi[0][l] = b.hi.x, w.hi[1][l] = b.hi.y, w.hi[2][l] = b.hi.z;
+    }
+  }
+
+  struct InstItem {
+    float t;
+    std::int16_t level;  ///< below 2^15: node ids hold at most 64 bits of levels
+    bool render;         ///< the LOD policy renders it (decided when pushed)
+    NodeId node;
+  };
+
   const H& h_;
   Lod lod_;
   Stats& counters_;
@@ -422,6 +605,7 @@ class Traversal {
   TriangleCandidate cand_{};
   TrianglePre tri_{};
   std::vector<StackItem> stack_;
+  std::vector<InstItem> istack_;  ///< the instanced fast path's stack
 };
 
 }  // namespace amalgam
