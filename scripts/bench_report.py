@@ -146,7 +146,7 @@ for s in scenes:
             b["embree_total_bytes_per_tri"]))
 L.append("\nBoth builders use all cores. \"of which bake\": `bake()` timed again alone on the built hierarchy.")
 L.append("Ours: nodes + appearances + primitives (48-byte triangles, reordered copy) + the SoA child")
-L.append("boxes of the SIMD traversal. Embree: bytes its device allocated during `rtcCommitScene`")
+L.append("boxes and triangle packs of the SIMD traversal. Embree: bytes its device allocated during `rtcCommitScene`")
 L.append("(memory monitor), and that plus the shared vertex/index buffers it was given.\n")
 L.append("## Whole renders of the field: Embree at full detail vs amalgam scale-sensitive\n")
 L.append("`build/bench/amalgam_field_bench` (bench/field_bench.cpp).")
