@@ -155,6 +155,41 @@ TEST(FuzzRegression, MeshPlyHeaderWithoutEnd) {
             g.path + ": malformed PLY header: no 'end_header' line");
 }
 
+// mesh_fuzz, crash-a020e4f5 (CI, 2026-11-22): an ASCII PLY whose property line reads
+// "property~ float green": the header check took it for a bare comment line (Wuson.ply has
+// such lines), Assimp 5.2 read it as a property and aborted in a post-processing step. Fixed:
+// a garbled structural keyword is an error.
+TEST(FuzzRegression, MeshPlyGarbledPropertyKeyword) {
+  const std::string bytes(
+      "1ply\n"
+      "format ascii 1.0\n"
+      "comment VCGLIB generated\n"
+      "element vertex 3\n"
+      "property float x\n"
+      "property float y\n"
+      "property float z\n"
+      "property float red\n"
+      "property~ float green\n"
+      "property float blue\n"
+      "property float alpha\n"
+      "element face 1\n"
+      "property list uchar int vertex_indices\n"
+      "end_header\n"
+      "0.0 0.0 0.0 0 0 1 1\n"
+      "100.0 0.0 0.0 0 0 1 1\n"
+      "200.0 200.0 0.0 0\xff\xff\xff\xff\xff\xff\xff\x00 0 1 2\n");
+  const TempFile f(mesh_input(bytes), ".ply");
+  EXPECT_EQ(error_of([&] { (void)import_mesh(f.path); }),
+            f.path + ": malformed PLY header: line 9 is 'property~ float green'");
+  // A bare comment line (no keyword) stays accepted, as in Wuson.ply.
+  const TempFile g(
+      "ply\nformat ascii 1.0\nCreated by hand\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+      ".ply");
+  EXPECT_NO_THROW((void)import_mesh(g.path));
+}
+
 // mesh_fuzz, crash-98a14a9c: an ASCII PLY whose "element vertex" line swallowed the next
 // property line: Assimp 5.2 read the faces wrongly and aborted on an assertion in its
 // triangulation step. Fixed with the same header check.

@@ -92,6 +92,22 @@ TEST(MeshImport, RealModelsLoadAndRender) {
   }
 }
 
+// Assimp runs in a child process: a crash inside it (here: the child aborts on purpose, as
+// Assimp 5.2 does on an assertion for some corrupt files) is one InputError naming the file,
+// and the process that asked carries on (the next import works).
+TEST(MeshImport, AnImporterCrashIsAnInputError) {
+  REQUIRE_MODELS();
+  const std::string path = (kModels / "PLY/Wuson.ply").string();
+  ::setenv("AMALGAM_TEST_IMPORTER_ABORT", "1", 1);
+  const std::string e = input_error([&] { (void)import_mesh(path); });
+  ::unsetenv("AMALGAM_TEST_IMPORTER_ABORT");
+  EXPECT_EQ(e, path + ": the importer crashed on this file (signal 6); is it corrupt?");
+  const ImportedMesh m = import_mesh(path);
+  EXPECT_EQ(m.triangles.size(), 3732u);
+  EXPECT_FALSE(m.materials.empty());
+  EXPECT_FALSE(m.bounds.empty());
+}
+
 TEST(MeshImport, Gltf2BaseColours) {
   REQUIRE_MODELS();
   const ImportedMesh m =
