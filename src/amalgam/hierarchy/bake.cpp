@@ -176,21 +176,31 @@ void orient(BakeResult& r, Vec3 outward, float weight) {
   r.app.shading = Shading::kOriented;
 }
 
+namespace {
+
+/// The surface and normal of a bake from sums over what the lines met, `weight` in all (> 0):
+/// mean colour, reflectance and shininess; the normal tensor scaled to trace 1, its dominant
+/// normal, and kCloud when it has none (contents not predominantly flat), else kNormal.
+void set_means(BakeResult& r, float weight, Vec3 colour, float spec, float shine,
+               NormalTensor normals) {
+  const float inv = 1.0f / weight;
+  r.app.surface.colour = colour * inv;
+  r.app.surface.reflectance = spec * inv;
+  r.app.surface.shininess = shine * inv;
+  const float tr = normals.trace();
+  if (tr > 0.0f) normals.scale(1.0f / tr);
+  r.normals = normals;
+  r.app.normal = dominant_normal(normals);
+  r.app.shading = r.app.normal == Vec3{} ? Shading::kCloud : Shading::kNormal;
+}
+
+}  // namespace
+
 BakeResult finish_bake(int rays, int hits, Vec3 colour, float spec, float shine,
                        NormalTensor normals) {
   BakeResult r;
   r.app.opacity = rays > 0 ? static_cast<float>(hits) / static_cast<float>(rays) : 0.0f;
-  if (hits > 0) {
-    const float inv = 1.0f / static_cast<float>(hits);
-    r.app.surface.colour = colour * inv;
-    r.app.surface.reflectance = spec * inv;
-    r.app.surface.shininess = shine * inv;
-    const float tr = normals.trace();
-    if (tr > 0.0f) normals.scale(1.0f / tr);
-    r.normals = normals;
-    r.app.normal = dominant_normal(normals);
-    r.app.shading = r.app.normal == Vec3{} ? Shading::kCloud : Shading::kNormal;
-  }
+  if (hits > 0) set_means(r, static_cast<float>(hits), colour, spec, shine, normals);
   return r;
 }
 
@@ -243,15 +253,7 @@ BakeResult bake_from_children(const Bbox& box, std::span<const BakeChild> kids, 
   BakeResult out;
   out.app.opacity = std::clamp(opacity / static_cast<float>(rays), 0.0f, 1.0f);
   if (weight > 0.0f) {
-    const float inv = 1.0f / weight;
-    out.app.surface.colour = colour * inv;
-    out.app.surface.reflectance = spec * inv;
-    out.app.surface.shininess = shine * inv;
-    const float tr = normals.trace();
-    if (tr > 0.0f) normals.scale(1.0f / tr);
-    out.normals = normals;
-    out.app.normal = dominant_normal(normals);
-    out.app.shading = out.app.normal == Vec3{} ? Shading::kCloud : Shading::kNormal;
+    set_means(out, weight, colour, spec, shine, normals);
     if (oriented) orient(out, outward, weight);
   }
   return out;
