@@ -52,7 +52,7 @@
 
 #include "amalgam/io/image.h"
 #include "amalgam/io/metrics.h"
-#include "amalgam/io/scene_file.h"
+#include "amalgam/load/load_scene.h"
 #include "amalgam/render/integrator.h"
 #include "amalgam/render/passes.h"
 #include "amalgam/render/render.h"

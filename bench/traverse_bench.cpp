@@ -5,7 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include "amalgam/render/integrator.h"
-#include "amalgam/scene/load.h"
+#include "amalgam/load/load_scene.h"
 
 namespace amalgam {
 namespace {

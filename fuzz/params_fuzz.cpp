@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "../apps/amalgam/common.h"
+#include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

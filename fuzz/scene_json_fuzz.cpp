@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <string>
 
-#include "amalgam/io/scene_file.h"
+#include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

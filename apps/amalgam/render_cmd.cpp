@@ -13,6 +13,7 @@
 #include "amalgam/io/checkpoint.h"
 #include "amalgam/io/image.h"
 #include "amalgam/io/stats_json.h"
+#include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
 #include "common.h"
 

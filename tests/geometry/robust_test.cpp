@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "amalgam/io/mesh_import.h"
-#include "amalgam/io/scene_file.h"
+#include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
 
 namespace amalgam {

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <numbers>
 
-#include "amalgam/io/scene_file.h"
+#include "amalgam/load/load_scene.h"
 #include "amalgam/math/random.h"
 #include "amalgam/render/render.h"
 

@@ -10,7 +10,8 @@
 #include <vector>
 
 #include "amalgam/io/mesh_import.h"
-#include "amalgam/io/scene_file.h"
+#include "amalgam/load/load_scene.h"
+#include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
 
 namespace amalgam {

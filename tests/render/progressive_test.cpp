@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "amalgam/io/checkpoint.h"
+#include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
 
 namespace amalgam {

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
 
 namespace amalgam {

@@ -15,7 +15,7 @@ inline LoadedScene scene(const std::string& name,
                          std::initializer_list<std::pair<std::string, std::string>> kv) {
   Params p("builtin:" + name);
   for (const auto& [k, v] : kv) p.set(k, v);
-  return load_scene("builtin:" + name, p);
+  return load_builtin("builtin:" + name, p);
 }
 
 inline std::string str(double v) {

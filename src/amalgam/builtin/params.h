@@ -4,15 +4,11 @@
 #include <cstdint>
 #include <map>
 #include <set>
-#include <stdexcept>
 #include <string>
 
-namespace amalgam {
+#include "amalgam/util/error.h"
 
-/// Thrown for bad user input; the CLI turns it into one line on stderr and exit status 2.
-struct InputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+namespace amalgam {
 
 /// The key=value pairs given with --set. Each builtin reads the keys it knows with a default
 /// and then calls `check_all_used`, so a misspelt key is an error, not silently ignored.
@@ -31,7 +27,6 @@ class Params {
                          const std::set<std::string>& allowed) const;
   /// Throws InputError for any key never read by a get_*.
   void check_all_used() const;
-  bool has(const std::string& key) const { return values_.count(key) != 0; }
 
  private:
   std::string scene_;

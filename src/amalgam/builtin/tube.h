@@ -15,7 +15,6 @@
 
 #include "amalgam/builtin/params.h"
 #include "amalgam/hierarchy/hierarchy.h"
-#include "amalgam/stats/counters.h"
 
 namespace amalgam {
 

@@ -32,6 +32,9 @@ struct HierarchyInfo {
   int levels = 0;         ///< l_max + 1
 };
 
+/// Upper bound on the number of levels of any hierarchy (root = level 0).
+inline constexpr int kMaxLevels = 64;
+
 /// Upper bound on the number of children of any node, for traversal's stack buffers.
 inline constexpr int kMaxChildren = 64;
 

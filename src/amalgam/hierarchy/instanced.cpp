@@ -12,48 +12,6 @@
 
 namespace amalgam {
 
-bool Transform::is_identity() const {
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 4; ++j)
-      if (m[i][j] != (i == j ? 1.0f : 0.0f)) return false;
-  return true;
-}
-
-Transform Transform::translate(Vec3 t) {
-  Transform r;
-  r.m[0][3] = t.x, r.m[1][3] = t.y, r.m[2][3] = t.z;
-  return r;
-}
-
-Transform Transform::inverse() const {
-  double a[3][3];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) a[i][j] = m[i][j];
-  const double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
-                     a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-                     a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-  double inv[3][3];
-  inv[0][0] = (a[1][1] * a[2][2] - a[1][2] * a[2][1]) / det;
-  inv[0][1] = (a[0][2] * a[2][1] - a[0][1] * a[2][2]) / det;
-  inv[0][2] = (a[0][1] * a[1][2] - a[0][2] * a[1][1]) / det;
-  inv[1][0] = (a[1][2] * a[2][0] - a[1][0] * a[2][2]) / det;
-  inv[1][1] = (a[0][0] * a[2][2] - a[0][2] * a[2][0]) / det;
-  inv[1][2] = (a[0][2] * a[1][0] - a[0][0] * a[1][2]) / det;
-  inv[2][0] = (a[1][0] * a[2][1] - a[1][1] * a[2][0]) / det;
-  inv[2][1] = (a[0][1] * a[2][0] - a[0][0] * a[2][1]) / det;
-  inv[2][2] = (a[0][0] * a[1][1] - a[0][1] * a[1][0]) / det;
-  Transform r;
-  for (int i = 0; i < 3; ++i) {
-    double t = 0.0;
-    for (int j = 0; j < 3; ++j) {
-      r.m[i][j] = static_cast<float>(inv[i][j]);
-      t -= inv[i][j] * m[j][3];
-    }
-    r.m[i][3] = static_cast<float>(t);
-  }
-  return r;
-}
-
 namespace {
 
 float box_area_ratio(const InstancedHierarchy::InstanceData& in, const Bbox& object,

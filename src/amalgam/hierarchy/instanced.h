@@ -23,32 +23,6 @@
 
 namespace amalgam {
 
-/// An affine map p -> M p + t, 3x4 row-major (column 3 is t).
-struct Transform {
-  float m[3][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}};
-
-  Vec3 point(Vec3 p) const {
-    return {m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3],
-            m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3],
-            m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3]};
-  }
-  Vec3 vector(Vec3 v) const {
-    return {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z,
-            m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
-            m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
-  }
-  bool is_identity() const;
-  /// The inverse map (computed in double precision). M must be non-singular.
-  Transform inverse() const;
-  static Transform translate(Vec3 t);
-};
-
-/// One placement of a mesh.
-struct Instance {
-  Transform to_world;
-  std::uint32_t mesh = 0;
-};
-
 class InstancedHierarchy {
  public:
   /// Precomputed per instance.

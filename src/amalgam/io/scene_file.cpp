@@ -15,17 +15,13 @@
 
 #include "amalgam/io/mesh_import.h"
 #include "amalgam/math/random.h"
+#include "amalgam/math/transform.h"
 
 namespace amalgam {
 namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 std::string fmt(double v) {
   std::ostringstream o;
@@ -47,53 +43,7 @@ void check_extent(const Bbox& b, const std::string& where) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Affine transforms (3x4, row-major).
-
-struct Affine {
-  double m[3][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}};
-
-  Vec3 apply(Vec3 p) const {
-    Vec3 r;
-    for (int i = 0; i < 3; ++i)
-      r[i] = static_cast<float>(m[i][0] * p.x + m[i][1] * p.y + m[i][2] * p.z + m[i][3]);
-    return r;
-  }
-  double det() const {
-    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-  }
-  static Affine translate(Vec3 t) {
-    Affine a;
-    a.m[0][3] = t.x, a.m[1][3] = t.y, a.m[2][3] = t.z;
-    return a;
-  }
-  static Affine scale(Vec3 s) {
-    Affine a;
-    a.m[0][0] = s.x, a.m[1][1] = s.y, a.m[2][2] = s.z;
-    return a;
-  }
-  /// Rotation by `deg` degrees about axis 0 (x), 1 (y) or 2 (z), right-handed.
-  static Affine rotate(int axis, double deg) {
-    const double r = deg * std::numbers::pi / 180.0, c = std::cos(r), s = std::sin(r);
-    const int i = (axis + 1) % 3, j = (axis + 2) % 3;
-    Affine a;
-    a.m[i][i] = c, a.m[i][j] = -s, a.m[j][i] = s, a.m[j][j] = c;
-    return a;
-  }
-};
-
-/// a * b: first b, then a.
-Affine operator*(const Affine& a, const Affine& b) {
-  Affine r;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 4; ++j) {
-      double v = j == 3 ? a.m[i][3] : 0.0;
-      for (int k = 0; k < 3; ++k) v += a.m[i][k] * b.m[k][j];
-      r.m[i][j] = v;
-    }
-  return r;
-}
+using Affine = AffineD;  // composed in double, rounded once per instance
 
 // ---------------------------------------------------------------------------------------------
 // Checked access to the JSON document: every error names the JSON pointer of the value.
@@ -346,7 +296,7 @@ class SceneParser {
           out_.instances.push_back(in);
           for (int c = 0; c < 8; ++c)
             bounds.extend(
-                a.apply({c & 1 ? object.hi.x : object.lo.x, c & 2 ? object.hi.y : object.lo.y,
+                a.point({c & 1 ? object.hi.x : object.lo.x, c & 2 ? object.hi.y : object.lo.y,
                          c & 4 ? object.hi.z : object.lo.z}));
         }
       }
@@ -758,11 +708,11 @@ class SceneParser {
       }
       for (const Primitive& t : m.mesh->triangles)
         out_.prims.push_back(
-            Primitive::triangle(a.apply(t.a), a.apply(t.b), a.apply(t.c), it->second + t.material));
+            Primitive::triangle(a.point(t.a), a.point(t.b), a.point(t.c), it->second + t.material));
     } else {
       for (const Primitive& t : m.mesh->triangles)
         out_.prims.push_back(
-            Primitive::triangle(a.apply(t.a), a.apply(t.b), a.apply(t.c), *material));
+            Primitive::triangle(a.point(t.a), a.point(t.b), a.point(t.c), *material));
     }
   }
 
@@ -890,38 +840,6 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
   d.env.camera = frame_camera(m.bounds);
   d.env.lights = default_lights(m.bounds, d.env.camera);
   return d;
-}
-
-AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config) {
-  if (d.instances.empty())
-    return build_explicit(std::move(d.prims), std::move(d.materials), config);
-  std::vector<ExplicitHierarchy> meshes;
-  meshes.reserve(d.meshes.size() + 1);
-  for (std::vector<Primitive>& m : d.meshes)
-    meshes.push_back(build_explicit(std::move(m), d.materials, config));
-  if (!d.prims.empty()) {
-    Instance loose;  // identity: traced bit-exactly as in an explicit hierarchy
-    loose.mesh = static_cast<std::uint32_t>(meshes.size());
-    meshes.push_back(build_explicit(std::move(d.prims), d.materials, config));
-    d.instances.push_back(loose);
-  }
-  return build_instanced(std::move(meshes), std::move(d.instances), config);
-}
-
-LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config) {
-  using Clock = std::chrono::steady_clock;
-  const auto t0 = Clock::now();
-  SceneDescription d = lower(fs::path(path).extension().string()) == ".json"
-                           ? read_scene_json(path, config)
-                           : mesh_scene(path, config);
-  const auto t1 = Clock::now();
-  Environment env = std::move(d.env);
-  AnyHierarchy h = build_hierarchy(std::move(d));
-  const auto t2 = Clock::now();
-  LoadedScene s{path, std::move(h), std::move(env)};
-  s.load_seconds = std::chrono::duration<double>(t1 - t0).count();
-  s.build_seconds = std::chrono::duration<double>(t2 - t1).count();
-  return s;
 }
 
 }  // namespace amalgam

@@ -6,7 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "amalgam/scene/load.h"
+#include "amalgam/scene/scene.h"
+#include "amalgam/util/error.h"
 
 namespace amalgam {
 
@@ -37,10 +38,6 @@ struct SceneDescription {
   std::vector<Instance> instances;
 };
 
-/// The hierarchy of a described scene: explicit when it has no instances, else instanced,
-/// with the loose primitives as one more mesh placed once, untransformed.
-AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config = {});
-
 /// Reads a scene file. Relative mesh paths resolve against the file's folder. Throws
 /// InputError naming the file and, for JSON syntax errors, the line and column, otherwise the
 /// JSON pointer of the offending value ("scene.json: /lights/0/intensity: expected an array
@@ -60,9 +57,5 @@ Camera frame_camera(const Bbox& bounds, float vfov_deg = 40.0f);
 /// A directional key light from above-left and a weaker point light at the camera (so that
 /// no visible surface is black).
 std::vector<Light> default_lights(const Bbox& bounds, const Camera& camera);
-
-/// Loads a scene path: `.json` (any case) as a scene file, anything else as a mesh; builds
-/// and bakes its hierarchy (build_hierarchy). Sets load_seconds (reading) and build_seconds.
-LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config = {});
 
 }  // namespace amalgam

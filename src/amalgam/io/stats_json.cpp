@@ -21,9 +21,9 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
   j["rays"] = {{"primary", c.rays[0]}, {"shadow", c.rays[1]}};
   json by_level = json::array();
   int last = 0;
-  for (int l = 0; l < kMaxLevels; ++l)
+  for (int l = 0; l < kCountedLevels; ++l)
     if (c.by_level[l]) last = l;
-  for (int l = 0; l <= std::max(last, info.levels - 1) && l < kMaxLevels; ++l)
+  for (int l = 0; l <= std::max(last, info.levels - 1) && l < kCountedLevels; ++l)
     by_level.push_back(c.by_level[l]);
   j["tests"] = {{"total", c.total()},
                 {"primary", c.tests_of(RayKind::kPrimary)},

@@ -4,7 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "amalgam/render/options.h"
-#include "amalgam/scene/load.h"
+#include "amalgam/render/loaded_scene.h"
 #include "amalgam/stats/counters.h"
 #include "amalgam/stats/distribution.h"
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "amalgam/render/options.h"
-#include "amalgam/scene/load.h"
+#include "amalgam/render/loaded_scene.h"
 #include "amalgam/stats/counters.h"
 #include "amalgam/stats/distribution.h"
 #include "amalgam/traverse/traverse.h"

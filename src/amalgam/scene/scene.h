@@ -8,6 +8,7 @@
 
 #include "amalgam/geometry/bbox.h"
 #include "amalgam/geometry/intersect.h"
+#include "amalgam/math/transform.h"
 
 namespace amalgam {
 
@@ -98,6 +99,12 @@ struct Camera {
   Ray centre_ray(int width, int height) const {
     return generate(width * 0.5f, height * 0.5f, width, height);
   }
+};
+
+/// One placement of a mesh: its object-space primitives mapped by `to_world`.
+struct Instance {
+  Transform to_world;
+  std::uint32_t mesh = 0;
 };
 
 /// Lights, camera and background: everything but the geometry.

@@ -13,17 +13,18 @@ enum class RayKind : std::uint8_t { kPrimary = 0, kShadow = 1 };
 /// node the renderer may render (amalgam).
 enum class ObjectKind : std::uint8_t { kPrimitive = 0, kBoundingVolume = 1, kAmalgam = 2 };
 
-inline constexpr int kMaxLevels = 64;
+/// Levels counted separately (`by_level`); deeper tests are counted on the last one.
+inline constexpr int kCountedLevels = 64;
 
 struct Counters {
   /// tests[ray kind][object kind]
   std::array<std::array<std::uint64_t, 3>, 2> tests{};
-  std::array<std::uint64_t, kMaxLevels> by_level{};
+  std::array<std::uint64_t, kCountedLevels> by_level{};
   std::array<std::uint64_t, 2> rays{};
 
   void count_test(RayKind r, ObjectKind o, int level) {
     ++tests[static_cast<int>(r)][static_cast<int>(o)];
-    ++by_level[static_cast<unsigned>(level) < kMaxLevels ? level : kMaxLevels - 1];
+    ++by_level[static_cast<unsigned>(level) < kCountedLevels ? level : kCountedLevels - 1];
   }
   void count_ray(RayKind r) { ++rays[static_cast<int>(r)]; }
 
@@ -39,7 +40,7 @@ struct Counters {
   void merge(const Counters& o) {
     for (int r = 0; r < 2; ++r)
       for (int k = 0; k < 3; ++k) tests[r][k] += o.tests[r][k];
-    for (int l = 0; l < kMaxLevels; ++l) by_level[l] += o.by_level[l];
+    for (int l = 0; l < kCountedLevels; ++l) by_level[l] += o.by_level[l];
     for (int r = 0; r < 2; ++r) rays[r] += o.rays[r];
   }
 };

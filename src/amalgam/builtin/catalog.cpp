@@ -1,10 +1,6 @@
-#include "amalgam/scene/load.h"
+#include "amalgam/builtin/catalog.h"
 
-#include <chrono>
 #include <cmath>
-#include <filesystem>
-
-#include "amalgam/io/scene_file.h"
 
 namespace amalgam {
 namespace {
@@ -13,7 +9,7 @@ constexpr double kMaxIndex = 0x1.0p58;  // node indices are packed into 58 bits
 
 int read_lights(const Params& p) { return static_cast<int>(p.get_int("lights", 1, 1, 64)); }
 
-LoadedScene make_tube(const std::string& name, const Params& p, TubeHierarchy::Mode mode) {
+BuiltinScene make_tube(const std::string& name, const Params& p, TubeHierarchy::Mode mode) {
   TubeHierarchy::Config c;
   c.mode = mode;
   c.n = static_cast<int>(p.get_int("n", mode == TubeHierarchy::Mode::kLine ? 3 : 2, 2, 64));
@@ -32,10 +28,10 @@ LoadedScene make_tube(const std::string& name, const Params& p, TubeHierarchy::M
   p.check_all_used();
   TubeHierarchy h(c);
   Environment env = h.environment(lights);
-  return LoadedScene{name, std::move(h), std::move(env)};
+  return BuiltinScene{name, std::move(h), std::move(env)};
 }
 
-LoadedScene make_prisms(const std::string& name, const Params& p, int default_depth,
+BuiltinScene make_prisms(const std::string& name, const Params& p, int default_depth,
                         const std::string& default_view) {
   PrismsHierarchy::Config c;
   c.split = static_cast<int>(p.get_int("split", 2, 2, 4));
@@ -51,7 +47,7 @@ LoadedScene make_prisms(const std::string& name, const Params& p, int default_de
                      " cells along an axis exceeds 2^19");
   PrismsHierarchy h(c);
   Environment env = h.environment(view, lights);
-  return LoadedScene{name, std::move(h), std::move(env)};
+  return BuiltinScene{name, std::move(h), std::move(env)};
 }
 
 }  // namespace
@@ -89,32 +85,16 @@ const std::vector<BuiltinDoc>& builtin_docs() {
   return docs;
 }
 
-LoadedScene load_scene(const std::string& spec, const Params& params) {
-  const auto t0 = std::chrono::steady_clock::now();
-  LoadedScene s;
+BuiltinScene make_builtin(const std::string& spec, const Params& params) {
   const std::string prefix = "builtin:";
-  if (spec.rfind(prefix, 0) == 0) {
-    const std::string name = spec.substr(prefix.size());
-    if (name == "line")
-      s = make_tube(spec, params, TubeHierarchy::Mode::kLine);
-    else if (name == "poisson")
-      s = make_tube(spec, params, TubeHierarchy::Mode::kPoisson);
-    else if (name == "prisms")
-      s = make_prisms(spec, params, 6, "front");
-    else if (name == "demo")
-      s = make_prisms(spec, params, 9, "corner");
-    else {
-      std::string list;
-      for (const auto& d : builtin_docs()) list += (list.empty() ? "" : ", ") + d.name;
-      throw InputError(spec + ": unknown builtin scene (expected one of " + list + ")");
-    }
-  } else {
-    if (!std::filesystem::exists(spec)) throw InputError(spec + ": no such file");
-    params.check_all_used();       // --set configures builtin scenes only
-    return load_scene_path(spec);  // .json scene file or mesh; times its own load and build
-  }
-  s.load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return s;
+  const std::string name = spec.rfind(prefix, 0) == 0 ? spec.substr(prefix.size()) : spec;
+  if (name == "line") return make_tube(spec, params, TubeHierarchy::Mode::kLine);
+  if (name == "poisson") return make_tube(spec, params, TubeHierarchy::Mode::kPoisson);
+  if (name == "prisms") return make_prisms(spec, params, 6, "front");
+  if (name == "demo") return make_prisms(spec, params, 9, "corner");
+  std::string list;
+  for (const auto& d : builtin_docs()) list += (list.empty() ? "" : ", ") + d.name;
+  throw InputError(spec + ": unknown builtin scene (expected one of " + list + ")");
 }
 
 }  // namespace amalgam

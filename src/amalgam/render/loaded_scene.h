@@ -1,14 +1,12 @@
 #pragma once
-/// \file Turning a SCENE argument (`builtin:NAME` + --set parameters, or a path) into a
-/// hierarchy and an environment.
+/// \file What `render` and `trace` take: a built, baked hierarchy of any form with its
+/// environment. Made by the front end's loader (load/load_scene.h) or, for the builtin scenes
+/// alone, by `load_builtin`.
 
 #include <string>
 #include <variant>
-#include <vector>
 
-#include "amalgam/builtin/params.h"
-#include "amalgam/builtin/prisms.h"
-#include "amalgam/builtin/tube.h"
+#include "amalgam/builtin/catalog.h"
 #include "amalgam/hierarchy/explicit.h"
 #include "amalgam/hierarchy/instanced.h"
 
@@ -31,15 +29,7 @@ struct LoadedScene {
   }
 };
 
-/// A builtin scene's documentation, for `amalgam scenes`.
-struct BuiltinDoc {
-  std::string name;
-  std::string summary;
-  std::vector<std::string> params;  ///< "key (default d, range): meaning"
-};
-const std::vector<BuiltinDoc>& builtin_docs();
-
-/// Loads `spec`. Throws InputError (one line naming the scene and the problem) on bad input.
-LoadedScene load_scene(const std::string& spec, const Params& params);
+/// A builtin scene (builtin/catalog.h) ready to render; sets load_seconds.
+LoadedScene load_builtin(const std::string& spec, const Params& params);
 
 }  // namespace amalgam

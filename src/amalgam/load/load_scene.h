@@ -1,0 +1,25 @@
+#pragma once
+/// \file The front end's scene loader: a SCENE argument (`builtin:NAME` + --set parameters, a
+/// `.json` scene file, or a mesh path) -> a built, baked hierarchy with its environment. The
+/// top layer of the library: it decides how a described scene is built (explicit or
+/// instanced) and composes the readers of io/ with the builders of hierarchy/.
+
+#include <string>
+
+#include "amalgam/io/scene_file.h"
+#include "amalgam/render/loaded_scene.h"
+
+namespace amalgam {
+
+/// The hierarchy of a described scene: explicit when it has no instances, else instanced,
+/// with the loose primitives as one more mesh placed once, untransformed.
+AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config = {});
+
+/// Loads a scene path: `.json` (any case) as a scene file, anything else as a mesh; builds
+/// and bakes its hierarchy (build_hierarchy). Sets load_seconds (reading) and build_seconds.
+LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config = {});
+
+/// Loads `spec`. Throws InputError (one line naming the scene and the problem) on bad input.
+LoadedScene load_scene(const std::string& spec, const Params& params);
+
+}  // namespace amalgam

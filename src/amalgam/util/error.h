@@ -1,0 +1,41 @@
+#pragma once
+/// \file The two kinds of failure, and the one rule that maps them to exit statuses.
+///
+/// - `InputError`: the user's input is wrong (a scene file, a mesh, an option, a checkpoint):
+///   one line naming the file and the place; the CLI exits 2.
+/// - `RuntimeError`: the input was fine but the work failed (a disk full, a write refused, a
+///   helper process killed); the CLI exits 1.
+/// - `InternalError` (thrown by AMALGAM_CHECK, check.h): a broken invariant of our own; exit 1.
+/// Any other std::exception is a runtime failure too.
+
+#include <exception>
+#include <stdexcept>
+#include <string>
+
+namespace amalgam {
+
+/// Bad user input. The message is one line: "<file or option>: <what is wrong>".
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// A failure of the work itself, not of its input (I/O, resources, a helper process).
+struct RuntimeError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// A violated internal invariant (a bug): see AMALGAM_CHECK in check.h.
+struct InternalError : std::logic_error {
+  using std::logic_error::logic_error;
+};
+
+/// Exit status for a failure: 2 for bad input, 1 for everything else.
+inline int exit_status(const std::exception& e) {
+  return dynamic_cast<const InputError*>(&e) != nullptr ? 2 : 1;
+}
+
+/// `text` cut to one line of at most `max` characters (newlines shown as spaces, an ellipsis
+/// where it was cut): for quoting user input inside an error message.
+std::string one_line(const std::string& text, std::size_t max = 120);
+
+}  // namespace amalgam
