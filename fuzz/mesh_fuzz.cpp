@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <string>
 
+#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/io/scene_file.h"
 #include "fuzz_util.h"
 

@@ -22,6 +22,7 @@
 #include <tuple>
 #include <vector>
 
+#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/io/mesh_import.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"

@@ -1,6 +1,7 @@
 // The two-level instanced hierarchy against the same scene expanded into one explicit
 // hierarchy, and the scene file producing it.
 
+#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/hierarchy/instanced.h"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,7 @@
 // Binned SAH builder and the bake: structural validity and opacity sanity.
 
-#include "amalgam/hierarchy/sah.h"
+#include "amalgam/hierarchy/build/build.h"
+#include "amalgam/hierarchy/build/sah.h"
 
 #include <gtest/gtest.h>
 

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "amalgam/hierarchy/flatten.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
 

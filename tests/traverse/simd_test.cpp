@@ -15,6 +15,8 @@
 #include <string>
 #include <type_traits>
 
+#include "amalgam/hierarchy/build/build.h"
+#include "amalgam/hierarchy/flatten.h"
 #include "amalgam/builtin/prisms.h"
 #include "amalgam/builtin/tube.h"
 #include "amalgam/hierarchy/explicit.h"

@@ -69,7 +69,6 @@ class TubeHierarchy {
   }
   const Config& config() const { return c_; }
   /// Number of primitives, n^l_max.
-  std::uint64_t primitive_count() const { return count_[c_.depth]; }
   /// The environment: camera at the origin looking down +x, point light(s) at the camera.
   Environment environment(int lights) const;
 

@@ -25,4 +25,11 @@ struct Bbox {
   friend constexpr bool operator==(const Bbox&, const Bbox&) = default;
 };
 
+/// Surface area of a box (0 for an empty box).
+inline float surface_area(const Bbox& b) {
+  if (b.empty()) return 0.0f;
+  const Vec3 e = b.extent();
+  return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
+}
+
 }  // namespace amalgam

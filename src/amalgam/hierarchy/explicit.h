@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "amalgam/hierarchy/bake.h"
+#include "amalgam/hierarchy/bake/normals.h"
 #include "amalgam/hierarchy/hierarchy.h"
 #include "amalgam/hierarchy/wide.h"
 
@@ -29,7 +29,8 @@ class ExplicitHierarchy {
   /// The normal tensor (trace 1) of the root's contents, from the bake: lets an instance
   /// level above compose normals across the instance boundary.
   NormalTensor root_normals;
-  /// SoA child boxes for the SIMD traversal (wide.h); built by `build_wide` at the end of `bake`.
+  /// SoA child boxes for the SIMD traversal (wide.h); built by `build_wide` at the end of `bake`
+  /// (hierarchy/bake/bake.h).
   WideNodes wide;
 
   NodeId root() const { return 0; }
@@ -54,35 +55,4 @@ class ExplicitHierarchy {
   }
 };
 
-/// Build settings for `build_explicit`.
-struct BuildConfig {
-  int arity = 4;      ///< children per interior node (2..kMaxChildren)
-  int leaf_size = 4;  ///< at most this many primitives in a leaf
-  int bins = 16;      ///< SAH bins per axis
-  bool parallel = true;
-  BakeConfig bake;
-};
-
-/// Builds a hierarchy over `prims` with a binned SAH (sah.h), collapsed to `arity`-wide
-/// nodes, in parallel, then bakes every amalgam's appearance bottom-up (see `bake`). Empty
-/// input gives a single empty leaf.
-ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surface> materials,
-                                 const BuildConfig& config = {});
-
-/// Bakes appearances bottom-up, one level at a time (parallel within a level). A node with
-/// at most `config.exact_prims` primitives below it is baked exactly: `config.rays` random
-/// lines through its box (bake.h) are traced against its subtree; opacity = fraction that
-/// hit, colour = mean colour of the surfaces hit, normal = dominant axis of their normals.
-/// A larger node combines its children's baked appearances along the same kind of lines
-/// (`bake_from_children`), so the bake costs O(nodes * rays * arity) beyond the bottom.
-void bake(ExplicitHierarchy& h, const BakeConfig& config = {});
-
-/// Copies a hierarchy that can list its primitives (`src.primitive(PrimId)`) into explicit
-/// form (breadth-first node order), keeping its appearances: the same scene, for
-/// differential tests of the two forms. Only for small hierarchies.
-template <Hierarchy H>
-ExplicitHierarchy flatten(const H& src, int max_levels);
-
 }  // namespace amalgam
-
-#include "amalgam/hierarchy/flatten.inl"

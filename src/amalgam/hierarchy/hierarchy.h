@@ -11,7 +11,7 @@
 
 #include "amalgam/geometry/bbox.h"
 #include "amalgam/geometry/intersect.h"
-#include "amalgam/scene/scene.h"
+#include "amalgam/hierarchy/appearance.h"
 
 namespace amalgam {
 

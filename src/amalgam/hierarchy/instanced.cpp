@@ -1,14 +1,8 @@
 #include "amalgam/hierarchy/instanced.h"
 
-#include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
-#include "amalgam/hierarchy/sah.h"
-#include "amalgam/math/random.h"
 
 namespace amalgam {
 
@@ -33,6 +27,28 @@ Bbox InstancedHierarchy::world_box(const InstanceData& in, const Bbox& b) {
   Vec3 r{dot(in.abs_rows[0], h), dot(in.abs_rows[1], h), dot(in.abs_rows[2], h)};
   r += (abs(c) + r) * (4.0f * gamma(3));  // rounding of the transform, conservatively
   return {c - r, c + r};
+}
+
+InstancedHierarchy::InstanceData InstancedHierarchy::make_instance(const Instance& inst,
+                                                                  const ExplicitHierarchy& mesh) {
+  InstanceData d;
+  d.to_world = inst.to_world;
+  d.to_object = inst.to_world.inverse();
+  d.mesh = inst.mesh;
+  d.identity = inst.to_world.is_identity();
+  const auto& m = inst.to_world.m;
+  const auto& q = d.to_object.m;
+  for (int i = 0; i < 3; ++i) {
+    d.normal_rows[i] = {q[0][i], q[1][i], q[2][i]};  // (M^-1)^T
+    d.abs_rows[i] = {std::fabs(m[i][0]), std::fabs(m[i][1]), std::fabs(m[i][2])};
+  }
+  const Vec3 col[3] = {
+      {m[0][0], m[1][0], m[2][0]}, {m[0][1], m[1][1], m[2][1]}, {m[0][2], m[1][2], m[2][2]}};
+  d.face_area[0] = length(cross(col[1], col[2]));
+  d.face_area[1] = length(cross(col[2], col[0]));
+  d.face_area[2] = length(cross(col[0], col[1]));
+  d.world_bounds = world_box(d, mesh.nodes[0].bounds);
+  return d;
 }
 
 Appearance InstancedHierarchy::appearance(NodeId n) const {
@@ -105,104 +121,6 @@ HierarchyInfo InstancedHierarchy::info() const {
   }
   i.levels = levels;
   return i;
-}
-
-InstancedHierarchy build_instanced(std::vector<ExplicitHierarchy> meshes,
-                                   std::vector<Instance> instances, const BuildConfig& config) {
-  InstancedHierarchy h;
-  h.meshes = std::move(meshes);
-  if (instances.size() >= 0xffffffffull)
-    throw std::invalid_argument("build_instanced: more than 2^32 - 2 instances");
-  h.instances.reserve(instances.size());
-  for (const Instance& inst : instances) {
-    if (inst.mesh >= h.meshes.size())
-      throw std::invalid_argument("build_instanced: mesh index out of range");
-    const ExplicitHierarchy& mesh = h.meshes[inst.mesh];
-    if (mesh.prims.empty()) continue;
-    InstancedHierarchy::InstanceData d;
-    d.to_world = inst.to_world;
-    d.to_object = inst.to_world.inverse();
-    d.mesh = inst.mesh;
-    d.identity = inst.to_world.is_identity();
-    const auto& m = inst.to_world.m;
-    const auto& q = d.to_object.m;
-    for (int i = 0; i < 3; ++i) {
-      d.normal_rows[i] = {q[0][i], q[1][i], q[2][i]};  // (M^-1)^T
-      d.abs_rows[i] = {std::fabs(m[i][0]), std::fabs(m[i][1]), std::fabs(m[i][2])};
-    }
-    const Vec3 col[3] = {
-        {m[0][0], m[1][0], m[2][0]}, {m[0][1], m[1][1], m[2][1]}, {m[0][2], m[1][2], m[2][2]}};
-    d.face_area[0] = length(cross(col[1], col[2]));
-    d.face_area[1] = length(cross(col[2], col[0]));
-    d.face_area[2] = length(cross(col[0], col[1]));
-    d.world_bounds = InstancedHierarchy::world_box(d, mesh.nodes[0].bounds);
-    h.instances.push_back(d);
-  }
-
-  // Top level: binned SAH over the instances' world boxes.
-  std::vector<Bbox> boxes(h.instances.size());
-  for (std::size_t i = 0; i < boxes.size(); ++i) boxes[i] = h.instances[i].world_bounds;
-  SahConfig sc;
-  sc.arity = config.arity;
-  sc.leaf_size = config.leaf_size;
-  sc.bins = config.bins;
-  sc.parallel = config.parallel;
-  const SahTree t = build_sah(boxes, sc);
-  h.top_items = t.order;
-  h.top_nodes.resize(t.nodes.size());
-  for (std::size_t i = 0; i < t.nodes.size(); ++i)
-    h.top_nodes[i] = {t.nodes[i].bounds, t.nodes[i].first, t.nodes[i].count, t.nodes[i].leaf};
-  h.levels = t.depth + 2;
-  for (std::size_t i = 0; i < t.nodes.size(); ++i) {
-    if (!t.nodes[i].leaf) continue;
-    for (std::uint32_t k = 0; k < t.nodes[i].count; ++k) {
-      const auto& in = h.instances[h.top_items[t.nodes[i].first + k]];
-      h.levels = std::max(h.levels, t.level[i] + 1 + h.meshes[in.mesh].levels);
-    }
-  }
-
-  // Bake the top level bottom-up from the instance roots.
-  h.top_appearances.assign(t.nodes.size(), Appearance{});
-  std::vector<NormalTensor> tensors(t.nodes.size());
-  const BakeConfig& bc = config.bake;
-  auto bake_one = [&](std::size_t i) {
-    const ExplicitNode& node = h.top_nodes[i];
-    BakeChild kids[kMaxChildren];
-    const int k = std::min<int>(node.count, kMaxChildren);
-    for (int c = 0; c < k; ++c) {
-      if (node.leaf) {
-        const std::uint32_t inst = h.top_items[node.first + c];
-        const auto& in = h.instances[inst];
-        const NodeId root = InstancedHierarchy::id(inst + 1ull, 0);
-        kids[c] = {in.world_bounds, h.appearance(root),
-                   in.identity ? h.meshes[in.mesh].root_normals
-                               : transform_tensor(h.meshes[in.mesh].root_normals, in.normal_rows)};
-      } else {
-        kids[c] = {h.top_nodes[node.first + c].bounds, h.top_appearances[node.first + c],
-                   tensors[node.first + c]};
-      }
-    }
-    const BakeResult r = bake_from_children(node.bounds, std::span<const BakeChild>(kids, k),
-                                            bc.rays, hash_combine(bc.seed ^ 0x70b, i));
-    h.top_appearances[i] = r.app;
-    tensors[i] = r.normals;
-  };
-  // Breadth-first order: levels never decrease with the index.
-  std::size_t end = t.nodes.size();
-  while (end > 0) {
-    std::size_t begin = end;
-    while (begin > 0 && t.level[begin - 1] == t.level[end - 1]) --begin;
-    if (config.parallel && end - begin > 64) {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 16),
-                        [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t i = r.begin(); i < r.end(); ++i) bake_one(i);
-                        });
-    } else {
-      for (std::size_t i = begin; i < end; ++i) bake_one(i);
-    }
-    end = begin;
-  }
-  return h;
 }
 
 }  // namespace amalgam

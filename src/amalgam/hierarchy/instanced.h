@@ -83,15 +83,11 @@ class InstancedHierarchy {
   /// The primitive in world space (for flatten() and tests).
   Primitive primitive(PrimId p) const;
 
+  /// The precomputed data of placement `inst` of `mesh` (built and baked).
+  static InstanceData make_instance(const Instance& inst, const ExplicitHierarchy& mesh);
+
   /// The world box of the transformed box `b` of instance `in` (conservative by a few ulps).
   static Bbox world_box(const InstanceData& in, const Bbox& b);
 };
-
-/// Builds the top level over `instances` (binned SAH, collapsed to `config.arity`), then
-/// bakes its amalgams from the instance roots. `meshes` must be built and baked already (see
-/// build_explicit); instances of empty meshes are dropped. Throws std::invalid_argument for
-/// a mesh index out of range or more than 2^32 - 2 instances.
-InstancedHierarchy build_instanced(std::vector<ExplicitHierarchy> meshes,
-                                   std::vector<Instance> instances, const BuildConfig& config = {});
 
 }  // namespace amalgam

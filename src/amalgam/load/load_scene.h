@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/io/scene_file.h"
 #include "amalgam/render/loaded_scene.h"
 

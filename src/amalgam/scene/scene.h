@@ -20,32 +20,6 @@ struct Surface {
   float shininess = 32.0f;        ///< Blinn-Phong exponent
 };
 
-/// How a rendered amalgam is shaded (src/amalgam/render/integrator.h).
-enum class Shading : std::uint8_t {
-  /// The normal of the box face the ray enters, or `Appearance::normal` when it is set: the
-  /// builtin scenes' exact box amalgams (and the default, so hand-made appearances keep it).
-  kFace,
-  /// `Appearance::normal`, turned toward the viewer: baked contents that are mostly flat.
-  kNormal,
-  /// A cloud of isotropically oriented Lambertian facets (the Lambert-sphere phase function):
-  /// baked contents that are not predominantly flat, e.g. a whole mesh seen from far away.
-  kCloud,
-  /// As kNormal, with `Appearance::normal` pointing out of the closed surfaces the contents
-  /// are part of: a ray meeting it from behind (dot(normal, dir) > 0) comes from inside, and
-  /// a ray that has not stopped yet is outside every object, so it passes (opacity 0 for it;
-  /// see directional_opacity in hierarchy/bake.h).
-  kOriented,
-};
-
-/// The visual attributes of an amalgam: a surface, an opacity, optionally a shading normal
-/// (zero means "use the normal of the box face the ray enters") and how to shade it.
-struct Appearance {
-  Surface surface;
-  float opacity = 1.0f;  ///< probability that a ray crossing the amalgam hits its contents
-  Vec3 normal{};
-  Shading shading = Shading::kFace;
-};
-
 enum class PrimKind : std::uint8_t { kTriangle, kSphere, kBox };
 
 /// One primitive. Triangle: a, b, c. Sphere: centre a, radius. Box: corners a (lo), b (hi).

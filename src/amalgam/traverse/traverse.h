@@ -34,7 +34,6 @@
 #include <type_traits>
 #include <vector>
 
-#include "amalgam/hierarchy/bake.h"
 #include "amalgam/hierarchy/hierarchy.h"
 #include "amalgam/hierarchy/wide.h"
 #include "amalgam/math/random.h"

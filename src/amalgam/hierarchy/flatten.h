@@ -1,7 +1,12 @@
 #pragma once
-// Implementation of amalgam::flatten (included from explicit.h).
+/// \file Copies a hierarchy that can list its primitives (`src.primitive(PrimId)`) into explicit
+/// form (breadth-first node order), keeping its appearances: the same scene, for differential
+/// tests of the two forms. Only for small hierarchies.
 
-#include <functional>
+#include <vector>
+
+#include "amalgam/hierarchy/explicit.h"
+#include "amalgam/util/check.h"
 
 namespace amalgam {
 
@@ -25,7 +30,7 @@ ExplicitHierarchy flatten(const H& src, int max_levels) {
       return true;
     });
     ExplicitNode& node = out.nodes[it.dst];
-    node.count = static_cast<std::uint16_t>(kids.size());
+    node.count = checked_narrow<std::uint16_t>(kids.size(), "flatten: child count");
     node.leaf = !kids.empty() && kids.front().is_primitive;
     if (node.leaf) {
       node.first = static_cast<std::uint32_t>(out.prims.size());

@@ -45,7 +45,4 @@ struct SahTree {
 /// every node's box is the union of its children's boxes.
 SahTree build_sah(std::span<const Bbox> boxes, const SahConfig& config = {});
 
-/// Surface area of a box (0 for an empty box).
-float surface_area(const Bbox& b);
-
 }  // namespace amalgam

@@ -1,4 +1,4 @@
-#include "amalgam/hierarchy/sah.h"
+#include "amalgam/hierarchy/build/sah.h"
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_invoke.h>
@@ -12,12 +12,6 @@
 #include "amalgam/hierarchy/hierarchy.h"
 
 namespace amalgam {
-
-float surface_area(const Bbox& b) {
-  if (b.empty()) return 0.0f;
-  const Vec3 e = b.extent();
-  return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
-}
 
 namespace {
 

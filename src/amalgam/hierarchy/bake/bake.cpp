@@ -1,52 +1,55 @@
-#include "amalgam/hierarchy/explicit.h"
+#include "amalgam/hierarchy/bake/bake.h"
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 
 #include <algorithm>
+#include <span>
+#include <vector>
 
-#include "amalgam/hierarchy/sah.h"
+#include "amalgam/hierarchy/bake/combine.h"
+#include "amalgam/hierarchy/bake/lines.h"
+#include "amalgam/hierarchy/bake/orientation.h"
 #include "amalgam/math/random.h"
+#include "amalgam/util/check.h"
 
 namespace amalgam {
+namespace {
 
-ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surface> materials,
-                                 const BuildConfig& config) {
-  ExplicitHierarchy h;
-  h.materials = std::move(materials);
-  if (h.materials.empty()) h.materials.push_back(Surface{});
-  std::vector<Bbox> boxes(prims.size());
-  auto each = [&](std::size_t n, auto&& f) {
-    if (config.parallel && n > 65536)
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384),
+/// Calls `bake_one(i)` for every node i, deepest level first, all nodes of a level before any
+/// of the level above (in parallel within a level when `parallel` and it is wide): the one
+/// bottom-up loop of every bake. `level[i]` is node i's level (root 0).
+template <class F>
+void for_each_level_bottom_up(std::span<const int> level, bool parallel, F&& bake_one) {
+  int max_level = 0;
+  for (int l : level) max_level = std::max(max_level, l);
+  std::vector<std::vector<std::uint32_t>> by_level(static_cast<std::size_t>(max_level) + 1);
+  for (std::size_t i = 0; i < level.size(); ++i)
+    by_level[static_cast<std::size_t>(level[i])].push_back(static_cast<std::uint32_t>(i));
+  for (int l = max_level; l >= 0; --l) {
+    const auto& ids = by_level[static_cast<std::size_t>(l)];
+    if (parallel && ids.size() > 64) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 16),
                         [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t i = r.begin(); i < r.end(); ++i) f(i);
+                          for (std::size_t j = r.begin(); j < r.end(); ++j) bake_one(ids[j]);
                         });
-    else
-      for (std::size_t i = 0; i < n; ++i) f(i);
-  };
-  each(prims.size(), [&](std::size_t i) { boxes[i] = bounds(prims[i]); });
-  SahConfig sc;
-  sc.arity = config.arity;
-  sc.leaf_size = config.leaf_size;
-  sc.bins = config.bins;
-  sc.parallel = config.parallel;
-  SahTree t = build_sah(boxes, sc);
-  boxes = {};
-  h.prims.resize(prims.size());
-  each(prims.size(), [&](std::size_t i) { h.prims[i] = prims[t.order[i]]; });
-  prims = {};
-  h.nodes.resize(t.nodes.size());
-  for (std::size_t i = 0; i < t.nodes.size(); ++i)
-    h.nodes[i] = {t.nodes[i].bounds, t.nodes[i].first, t.nodes[i].count, t.nodes[i].leaf};
-  h.levels = t.depth + 2;  // primitives one level below the deepest leaf
-  BakeConfig bc = config.bake;
-  bc.parallel = bc.parallel && config.parallel;
-  bake(h, bc);
-  return h;
+    } else {
+      for (std::uint32_t id : ids) bake_one(id);
+    }
+  }
 }
 
-namespace {
+/// Levels of `nodes` (children always have larger indices than their parent).
+std::vector<int> node_levels(const std::vector<ExplicitNode>& nodes) {
+  std::vector<int> level(nodes.size(), 0);
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    if (!nodes[i].leaf)
+      for (std::uint32_t c = 0; c < nodes[i].count; ++c) {
+        AMALGAM_CHECK(nodes[i].first + c > i, "bake: a child precedes its parent");
+        level[nodes[i].first + c] = level[i] + 1;
+      }
+  return level;
+}
 
 /// Exact bake of node `id`: random lines traced (closest hit) against its subtree.
 /// `orientation`: closed_orientation of the hierarchy's primitives (0: triangles have no
@@ -126,12 +129,7 @@ void bake(ExplicitHierarchy& h, const BakeConfig& config) {
   h.appearances.assign(n, Appearance{});
   std::vector<NormalTensor> tensors(n);
   std::vector<std::uint64_t> prims_below(n, 0);
-  std::vector<int> level(n, 0);
-  // Children always have larger indices than their parent.
-  for (std::size_t i = 0; i < n; ++i)
-    if (!h.nodes[i].leaf)
-      for (std::uint32_t c = 0; c < h.nodes[i].count; ++c)
-        level[h.nodes[i].first + c] = level[i] + 1;
+  const std::vector<int> level = node_levels(h.nodes);
   for (std::size_t i = n; i-- > 0;) {
     const ExplicitNode& node = h.nodes[i];
     if (node.leaf) {
@@ -147,7 +145,8 @@ void bake(ExplicitHierarchy& h, const BakeConfig& config) {
       r = bake_exact(h, static_cast<std::uint32_t>(i), config, orientation);
     } else {
       BakeChild kids[kMaxChildren];
-      const int k = std::min<int>(node.count, kMaxChildren);
+      AMALGAM_CHECK(node.count <= kMaxChildren, "bake: a node with more than kMaxChildren children");
+      const int k = node.count;
       for (int c = 0; c < k; ++c)
         kids[c] = {h.nodes[node.first + c].bounds, h.appearances[node.first + c],
                    tensors[node.first + c]};
@@ -157,26 +156,39 @@ void bake(ExplicitHierarchy& h, const BakeConfig& config) {
     h.appearances[i] = r.app;
     tensors[i] = r.normals;
   };
-  // Levels never decrease with the index in breadth-first order; but flatten() and hand-made
-  // hierarchies need only "children after parents", so group by level explicitly.
-  int max_level = 0;
-  for (int l : level) max_level = std::max(max_level, l);
-  std::vector<std::vector<std::uint32_t>> by_level(static_cast<std::size_t>(max_level) + 1);
-  for (std::size_t i = 0; i < n; ++i)
-    by_level[static_cast<std::size_t>(level[i])].push_back(static_cast<std::uint32_t>(i));
-  for (int l = max_level; l >= 0; --l) {
-    const auto& ids = by_level[static_cast<std::size_t>(l)];
-    if (config.parallel && ids.size() > 64) {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 32),
-                        [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t j = r.begin(); j < r.end(); ++j) bake_one(ids[j]);
-                        });
-    } else {
-      for (std::uint32_t id : ids) bake_one(id);
-    }
-  }
+  for_each_level_bottom_up(level, config.parallel, bake_one);
   h.root_normals = n ? tensors[0] : NormalTensor{};
   build_wide(h);
+}
+
+void bake(InstancedHierarchy& h, const BakeConfig& config) {
+  h.top_appearances.assign(h.top_nodes.size(), Appearance{});
+  std::vector<NormalTensor> tensors(h.top_nodes.size());
+  const BakeConfig& bc = config;
+  auto bake_one = [&](std::size_t i) {
+    const ExplicitNode& node = h.top_nodes[i];
+    BakeChild kids[kMaxChildren];
+    AMALGAM_CHECK(node.count <= kMaxChildren, "bake: a node with more than kMaxChildren children");
+    const int k = node.count;
+    for (int c = 0; c < k; ++c) {
+      if (node.leaf) {
+        const std::uint32_t inst = h.top_items[node.first + c];
+        const auto& in = h.instances[inst];
+        const NodeId root = InstancedHierarchy::id(inst + 1ull, 0);
+        kids[c] = {in.world_bounds, h.appearance(root),
+                   in.identity ? h.meshes[in.mesh].root_normals
+                               : transform_tensor(h.meshes[in.mesh].root_normals, in.normal_rows)};
+      } else {
+        kids[c] = {h.top_nodes[node.first + c].bounds, h.top_appearances[node.first + c],
+                   tensors[node.first + c]};
+      }
+    }
+    const BakeResult r = bake_from_children(node.bounds, std::span<const BakeChild>(kids, k),
+                                            bc.rays, hash_combine(bc.seed ^ 0x70b, i));
+    h.top_appearances[i] = r.app;
+    tensors[i] = r.normals;
+  };
+  for_each_level_bottom_up(node_levels(h.top_nodes), config.parallel, bake_one);
 }
 
 }  // namespace amalgam

@@ -1,0 +1,82 @@
+#include "amalgam/hierarchy/bake/orientation.h"
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_reduce.h>
+#include <oneapi/tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <functional>
+#include <vector>
+
+#include "amalgam/math/random.h"
+
+namespace amalgam {
+
+int closed_orientation(std::span<const Primitive> prims) {
+  // Each directed edge a->b as one 64-bit key: a hash of the unordered pair of its end points
+  // (their bits) in the high 63 bits, the direction in the low bit (0: from the lower vertex
+  // hash to the higher). Sorted, the two sides of an edge of a closed, consistently wound
+  // surface are a run of exactly two keys with both bits; a run of one is a hole's edge, and
+  // anything else (a directed edge twice, a non-manifold edge) is inconsistent. Collisions:
+  // about n^2 / 2^64, negligible below 10^8. Closed up to small holes: at least 95 % of the
+  // directed edges paired (real meshes have some: Wuson.ply's eyes and seams leave 412 of its
+  // 11,196 directed edges unpaired).
+  auto key = [](Vec3 p) {
+    return hash_combine(hash_combine(hash_combine(0x0e1d6e5, std::bit_cast<std::uint32_t>(p.x)),
+                                     std::bit_cast<std::uint32_t>(p.y)),
+                        std::bit_cast<std::uint32_t>(p.z));
+  };
+  std::vector<const Primitive*> tris;
+  tris.reserve(prims.size());
+  for (const Primitive& t : prims)
+    if (t.kind == PrimKind::kTriangle) tris.push_back(&t);
+  if (tris.empty()) return 0;
+  std::vector<std::uint64_t> edges(3 * tris.size());
+  // Degenerate triangles (two vertices the same) are left out: their keys sort last.
+  constexpr std::uint64_t kSkip = ~std::uint64_t{0};
+  std::atomic<std::size_t> skipped{0};
+  // Six times the enclosed signed volume.
+  const double volume = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, tris.size(), 4096), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& r, double v) {
+        for (std::size_t i = r.begin(); i < r.end(); ++i) {
+          const Primitive& t = *tris[i];
+          const std::uint64_t k[3] = {key(t.a), key(t.b), key(t.c)};
+          if (k[0] == k[1] || k[1] == k[2] || k[2] == k[0]) {
+            for (int e = 0; e < 3; ++e) edges[3 * i + static_cast<std::size_t>(e)] = kSkip;
+            skipped.fetch_add(3, std::memory_order_relaxed);
+            continue;
+          }
+          for (int e = 0; e < 3; ++e) {
+            const std::uint64_t a = k[e], b = k[(e + 1) % 3];
+            const std::uint64_t h = hash_combine(std::min(a, b), std::max(a, b));
+            edges[3 * i + static_cast<std::size_t>(e)] = (h & ~std::uint64_t{1}) | (a < b ? 0 : 1);
+          }
+          const Vec3 c = cross(t.b, t.c);
+          v += static_cast<double>(t.a.x) * c.x + static_cast<double>(t.a.y) * c.y +
+               static_cast<double>(t.a.z) * c.z;
+        }
+        return v;
+      },
+      std::plus<double>());
+  tbb::parallel_sort(edges.begin(), edges.end());
+  edges.resize(edges.size() - skipped.load());
+  if (edges.empty()) return 0;
+  std::size_t paired = 0;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && (edges[j] >> 1) == (edges[i] >> 1)) ++j;
+    if (j - i == 2 && edges[i] != edges[i + 1]) {
+      paired += 2;
+    } else if (j - i != 1) {
+      return 0;
+    }
+    i = j;
+  }
+  if (paired * 20 < edges.size() * 19) return 0;
+  return volume > 0.0 ? 1 : volume < 0.0 ? -1 : 0;
+}
+
+}  // namespace amalgam

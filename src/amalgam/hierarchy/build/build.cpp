@@ -1,0 +1,102 @@
+#include "amalgam/hierarchy/build/build.h"
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+
+#include <algorithm>
+
+#include "amalgam/hierarchy/build/sah.h"
+#include "amalgam/util/check.h"
+
+namespace amalgam {
+namespace {
+
+SahConfig sah_config(const BuildConfig& config) {
+  AMALGAM_CHECK(config.arity >= 2 && config.arity <= kMaxChildren,
+                "BuildConfig::arity must be in [2, kMaxChildren]");
+  AMALGAM_CHECK(config.leaf_size >= 1 && config.leaf_size <= kMaxChildren,
+                "BuildConfig::leaf_size must be in [1, kMaxChildren]");
+  SahConfig sc;
+  sc.arity = config.arity;
+  sc.leaf_size = config.leaf_size;
+  sc.bins = config.bins;
+  sc.parallel = config.parallel;
+  return sc;
+}
+
+/// The nodes of a SAH tree as an explicit hierarchy stores them.
+std::vector<ExplicitNode> explicit_nodes(const SahTree& t) {
+  std::vector<ExplicitNode> nodes(t.nodes.size());
+  for (std::size_t i = 0; i < t.nodes.size(); ++i) {
+    AMALGAM_CHECK(t.nodes[i].count <= kMaxChildren, "SAH node with more than kMaxChildren children");
+    nodes[i] = {t.nodes[i].bounds, t.nodes[i].first, t.nodes[i].count, t.nodes[i].leaf};
+  }
+  return nodes;
+}
+
+}  // namespace
+
+ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surface> materials,
+                                 const BuildConfig& config) {
+  ExplicitHierarchy h;
+  h.materials = std::move(materials);
+  if (h.materials.empty()) h.materials.push_back(Surface{});
+  std::vector<Bbox> boxes(prims.size());
+  auto each = [&](std::size_t n, auto&& f) {
+    if (config.parallel && n > 65536)
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t i = r.begin(); i < r.end(); ++i) f(i);
+                        });
+    else
+      for (std::size_t i = 0; i < n; ++i) f(i);
+  };
+  each(prims.size(), [&](std::size_t i) { boxes[i] = bounds(prims[i]); });
+  SahTree t = build_sah(boxes, sah_config(config));
+  boxes = {};
+  h.prims.resize(prims.size());
+  each(prims.size(), [&](std::size_t i) { h.prims[i] = prims[t.order[i]]; });
+  prims = {};
+  h.nodes = explicit_nodes(t);
+  h.levels = t.depth + 2;  // primitives one level below the deepest leaf
+  BakeConfig bc = config.bake;
+  bc.parallel = bc.parallel && config.parallel;
+  bake(h, bc);
+  return h;
+}
+
+InstancedHierarchy build_instanced(std::vector<ExplicitHierarchy> meshes,
+                                   std::vector<Instance> instances, const BuildConfig& config) {
+  InstancedHierarchy h;
+  h.meshes = std::move(meshes);
+  AMALGAM_CHECK(instances.size() < 0xffffffffull, "build_instanced: more than 2^32 - 2 instances");
+  h.instances.reserve(instances.size());
+  for (const Instance& inst : instances) {
+    AMALGAM_CHECK(inst.mesh < h.meshes.size(), "build_instanced: mesh index out of range");
+    const ExplicitHierarchy& mesh = h.meshes[inst.mesh];
+    if (mesh.prims.empty()) continue;
+    h.instances.push_back(InstancedHierarchy::make_instance(inst, mesh));
+  }
+
+  // Top level: binned SAH over the instances' world boxes.
+  std::vector<Bbox> boxes(h.instances.size());
+  for (std::size_t i = 0; i < boxes.size(); ++i) boxes[i] = h.instances[i].world_bounds;
+  const SahTree t = build_sah(boxes, sah_config(config));
+  h.top_items = t.order;
+  h.top_nodes = explicit_nodes(t);
+  h.levels = t.depth + 2;
+  for (std::size_t i = 0; i < t.nodes.size(); ++i) {
+    if (!t.nodes[i].leaf) continue;
+    for (std::uint32_t k = 0; k < t.nodes[i].count; ++k) {
+      const auto& in = h.instances[h.top_items[t.nodes[i].first + k]];
+      h.levels = std::max(h.levels, t.level[i] + 1 + h.meshes[in.mesh].levels);
+    }
+  }
+
+  BakeConfig bc = config.bake;
+  bc.parallel = bc.parallel && config.parallel;
+  bake(h, bc);
+  return h;
+}
+
+}  // namespace amalgam
