@@ -44,7 +44,7 @@
 #include "amalgam/hierarchy/bake/bake.h"
 #include "amalgam/hierarchy/explicit.h"
 #include "amalgam/io/mesh_import.h"
-#include "amalgam/traverse/policies.h"
+#include "amalgam/traverse/lod.h"
 #include "amalgam/traverse/traverse.h"
 
 namespace amalgam {
@@ -52,7 +52,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using OurTraversal =
-    Traversal<ExplicitHierarchy, TraditionalLod, OpacityModel::kStochastic, true, NullCounters>;
+    Traversal<ExplicitHierarchy, TraditionalLod, StochasticOpacity, SortedOrder, NullCounters>;
 
 const char* const kWuson = "/usr/share/assimp/models/PLY/Wuson.ply";
 const char* const kEngine =

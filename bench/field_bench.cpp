@@ -232,8 +232,8 @@ class EmbreeTracer {
   const EmbreeField* f_;
 };
 
-using EmbreeIntegrator = Integrator<InstancedHierarchy, TraditionalLod, OpacityModel::kStochastic,
-                                    true, Counters, EmbreeTracer>;
+using EmbreeIntegrator = Integrator<InstancedHierarchy, TraditionalLod, StochasticOpacity,
+                                    SortedOrder, Counters, EmbreeTracer>;
 
 // ---- scenes ----------------------------------------------------------------------------------
 

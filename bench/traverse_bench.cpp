@@ -18,7 +18,7 @@ void trace_image(benchmark::State& state, const char* scene_depth, Lod lod) {
   const LoadedScene scene = load_scene("builtin:prisms", p);
   const auto& h = std::get<PrismsHierarchy>(scene.hierarchy);
   Stats stats;
-  Integrator<PrismsHierarchy, Lod, OpacityModel::kStochastic, true, Stats> integ(h, scene.env,
+  Integrator<PrismsHierarchy, Lod, StochasticOpacity, SortedOrder, Stats> integ(h, scene.env,
                                                                                  lod, stats);
   const int w = 128, hgt = 128;
   std::uint64_t rays = 0;

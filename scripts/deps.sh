@@ -8,7 +8,7 @@ packages=(
   libgtest-dev libbenchmark-dev
   libassimp-dev assimp-testmodels
   libembree-dev
-  gnuplot-nox python3
+  gnuplot-nox python3 qemu-user
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,6 +1,7 @@
 // The two-level instanced hierarchy against the same scene expanded into one explicit
 // hierarchy, and the scene file producing it.
 
+#include "amalgam/traverse/traverse.h"
 #include "amalgam/hierarchy/build/build.h"
 #include "amalgam/hierarchy/instanced.h"
 
@@ -122,8 +123,8 @@ void expect_same_hits(const std::vector<Transform>& where) {
   const auto& in = std::get<InstancedHierarchy>(p.instanced.hierarchy);
   EXPECT_EQ(e.info().primitives, in.info().primitives);
   Counters ce, ci;
-  Traversal<ExplicitHierarchy, TraditionalLod, OpacityModel::kStochastic, true> te(e, {}, ce);
-  Traversal<InstancedHierarchy, TraditionalLod, OpacityModel::kStochastic, true> ti(in, {}, ci);
+  Traversal<ExplicitHierarchy, TraditionalLod, StochasticOpacity, SortedOrder> te(e, {}, ce);
+  Traversal<InstancedHierarchy, TraditionalLod, StochasticOpacity, SortedOrder> ti(in, {}, ci);
   int hits = 0, same_prim = 0, n = 0;
   for (int y = 0; y < 60; ++y)
     for (int x = 0; x < 80; ++x, ++n) {

@@ -23,7 +23,7 @@
 #include "amalgam/hierarchy/instanced.h"
 #include "amalgam/hierarchy/wide.h"
 #include "amalgam/io/mesh_import.h"
-#include "amalgam/traverse/policies.h"
+#include "amalgam/traverse/lod.h"
 #include "amalgam/traverse/reference.h"
 #include "amalgam/traverse/traverse.h"
 
@@ -82,11 +82,11 @@ void expect_same_hit(const TraceHit& a, const TraceHit& b, const std::string& wh
 }
 
 /// Fast vs reference on `rays`, closest hit and shadow, one policy combination.
-template <class H, class Lod, OpacityModel kOpacity, bool kSorted>
+template <class H, class Lod, class Opacity, class Order>
 void compare(const H& h, const Lod& lod, const std::vector<Ray>& rays, const std::string& name) {
   Counters cf, cr;
-  Traversal<H, Lod, kOpacity, kSorted> fast(h, lod, cf);
-  ReferenceTraversal<H, Lod, kOpacity, kSorted> ref(h, lod, cr);
+  Traversal<H, Lod, Opacity, Order> fast(h, lod, cf);
+  ReferenceTraversal<H, Lod, Opacity, Order> ref(h, lod, cr);
   std::vector<TranslucentHit> tf, tr;
   int hits = 0;
   const bool failed_before = ::testing::Test::HasFailure();
@@ -111,13 +111,13 @@ void compare(const H& h, const Lod& lod, const std::vector<Ray>& rays, const std
 
 template <class H>
 void compare_all(const H& h, const std::vector<Ray>& rays, int levels, const std::string& name) {
-  auto each_order = [&]<class Lod, OpacityModel kO>(const Lod& lod, const std::string& n) {
-    compare<H, Lod, kO, true>(h, lod, rays, n + " sorted");
-    compare<H, Lod, kO, false>(h, lod, rays, n + " unsorted");
+  auto each_order = [&]<class Lod, class Opacity>(const Lod& lod, const std::string& n) {
+    compare<H, Lod, Opacity, SortedOrder>(h, lod, rays, n + " sorted");
+    compare<H, Lod, Opacity, StoredOrder>(h, lod, rays, n + " unsorted");
   };
   auto each_opacity = [&]<class Lod>(const Lod& lod, const std::string& n) {
-    each_order.template operator()<Lod, OpacityModel::kStochastic>(lod, n + " stochastic");
-    each_order.template operator()<Lod, OpacityModel::kDeterministic>(lod, n + " deterministic");
+    each_order.template operator()<Lod, StochasticOpacity>(lod, n + " stochastic");
+    each_order.template operator()<Lod, DeterministicOpacity>(lod, n + " deterministic");
   };
   each_opacity(TraditionalLod{}, name + " traditional");
   for (int l : {0, 1, levels / 2, levels - 2})

@@ -16,6 +16,7 @@
 /// the transformed box with probability area ratio) and the normal transformed; top-level
 /// amalgams are baked from the instance roots (`bake_from_children`).
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -88,6 +89,90 @@ class InstancedHierarchy {
 
   /// The world box of the transformed box `b` of instance `in` (conservative by a few ulps).
   static Bbox world_box(const InstanceData& in, const Bbox& b);
+
+  /// The children of node `n` for the traversal's SIMD test (hierarchy/wide.h): top-level
+  /// nodes' and instance roots' world boxes as stored; inside an instance, the world box of
+  /// each child's transformed box, computed four at a time with the float operations of
+  /// `world_box` in the same order (bit-identical to it); for a leaf inside an instance, its
+  /// primitives' ids.
+  void gather_children(NodeId n, GatheredChildren& out) const {
+    const std::uint64_t s = slot(n);
+    if (s == 0) {
+      const ExplicitNode& t = top_nodes[n];
+      out.count = static_cast<int>(t.count);
+      out.primitives = false;
+      for (int i = 0; i < out.count; ++i) {
+        if (t.leaf) {
+          const std::uint32_t inst = top_items[t.first + static_cast<std::uint32_t>(i)];
+          out.ids[i] = id(inst + 1ull, 0);
+          out.put_box(i, instances[inst].world_bounds);
+        } else {
+          out.ids[i] = t.first + static_cast<std::uint32_t>(i);
+          out.put_box(i, top_nodes[t.first + static_cast<std::uint32_t>(i)].bounds);
+        }
+      }
+      return;
+    }
+    const InstanceData& in = instances[s - 1];
+    const ExplicitHierarchy& mesh = meshes[in.mesh];
+    const ExplicitNode& e = mesh.nodes[local(n)];
+    out.count = static_cast<int>(e.count);
+    out.primitives = e.leaf;
+    for (int i = 0; i < out.count; ++i) out.ids[i] = id(s, e.first + static_cast<std::uint32_t>(i));
+    if (e.leaf) return;
+    for (int i = 0; i < out.count; ++i)
+      out.put_box(i, mesh.nodes[e.first + static_cast<std::uint32_t>(i)].bounds);
+    if (!in.identity) {
+      for (int c0 = 0; c0 < out.count; c0 += kWideLanes)
+        world_boxes4(in, out.boxes[c0 / kWideLanes], std::min(out.count - c0, kWideLanes));
+    }
+  }
+
+ private:
+  /// Replaces the first `n` object-space boxes of `w` by world_box of each (empty boxes stay
+  /// as they are, as there).
+  static void world_boxes4(const InstanceData& in, WideBox4& w, int n) {
+#if AMALGAM_WIDE_SSE
+    bool any_empty = false;
+    for (int l = 0; l < n; ++l)
+      any_empty |= w.lo[0][l] > w.hi[0][l] || w.lo[1][l] > w.hi[1][l] || w.lo[2][l] > w.hi[2][l];
+    if (!any_empty) {
+      const __m128 half = _mm_set1_ps(0.5f);
+      const __m128 sign = _mm_set1_ps(-0.0f);
+      const __m128 k = _mm_set1_ps(4.0f * gamma(3));
+      __m128 c[3], h[3];
+      for (int a = 0; a < 3; ++a) {
+        const __m128 lo = _mm_load_ps(w.lo[a]), hi = _mm_load_ps(w.hi[a]);
+        c[a] = _mm_mul_ps(_mm_add_ps(lo, hi), half);  // Bbox::center
+        h[a] = _mm_mul_ps(_mm_sub_ps(hi, lo), half);  // Bbox::extent() * 0.5f
+      }
+      for (int r = 0; r < 3; ++r) {
+        const float* m = in.to_world.m[r];
+        // Transform::point: ((m0 x + m1 y) + m2 z) + m3.
+        __m128 cw = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(m[0]), c[0]),
+                                                     _mm_mul_ps(_mm_set1_ps(m[1]), c[1])),
+                                          _mm_mul_ps(_mm_set1_ps(m[2]), c[2])),
+                               _mm_set1_ps(m[3]));
+        // dot(abs_rows[r], h): (x + y) + z.
+        const Vec3 ar = in.abs_rows[r];
+        __m128 rw = _mm_add_ps(
+            _mm_add_ps(_mm_mul_ps(_mm_set1_ps(ar.x), h[0]), _mm_mul_ps(_mm_set1_ps(ar.y), h[1])),
+            _mm_mul_ps(_mm_set1_ps(ar.z), h[2]));
+        // r += (|c| + r) * 4 gamma(3)
+        rw = _mm_add_ps(rw, _mm_mul_ps(_mm_add_ps(_mm_andnot_ps(sign, cw), rw), k));
+        _mm_store_ps(w.lo[r], _mm_sub_ps(cw, rw));
+        _mm_store_ps(w.hi[r], _mm_add_ps(cw, rw));
+      }
+      return;
+    }
+#endif
+    for (int l = 0; l < n; ++l) {
+      const Bbox b = world_box(
+          in, Bbox{{w.lo[0][l], w.lo[1][l], w.lo[2][l]}, {w.hi[0][l], w.hi[1][l], w.hi[2][l]}});
+      w.lo[0][l] = b.lo.x, w.lo[1][l] = b.lo.y, w.lo[2][l] = b.lo.z;
+      w.hi[0][l] = b.hi.x, w.hi[1][l] = b.hi.y, w.hi[2][l] = b.hi.z;
+    }
+  }
 };
 
 }  // namespace amalgam

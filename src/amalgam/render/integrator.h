@@ -16,6 +16,7 @@
 #include "amalgam/traverse/traverse.h"
 
 namespace amalgam {
+AMALGAM_ISA_BEGIN
 
 struct SampleResult {
   Vec3 colour;
@@ -25,8 +26,8 @@ struct SampleResult {
 /// `Tracer` finds hits: `intersect(ray, key, translucent*) -> TraceHit` and
 /// `transmittance(ray, key) -> float`. It is amalgam's Traversal; the benchmarks substitute
 /// Intel Embree (bench/field_bench.cpp) to render the same image with another ray tracer.
-template <Hierarchy H, class Lod, OpacityModel kOpacity, bool kSorted, class Stats = Counters,
-          class Tracer = Traversal<H, Lod, kOpacity, kSorted, Stats>>
+template <Hierarchy H, class Lod, class Opacity, class Order = SortedOrder,
+          class Stats = Counters, class Tracer = Traversal<H, Lod, Opacity, Order, Stats>>
 class Integrator {
  public:
   Integrator(const H& h, const Environment& env, const Lod& lod, Stats& counters)
@@ -39,11 +40,11 @@ class Integrator {
     translucent_.clear();
     const TraceHit hit =
         trav_.intersect(primary, hash_combine(key, 0),
-                        kOpacity == OpacityModel::kDeterministic ? &translucent_ : nullptr);
+                        Opacity::kBlends ? &translucent_ : nullptr);
     std::uint64_t shadow_stream = 1;
     Vec3 colour{};
     float through = 1.0f;
-    if constexpr (kOpacity == OpacityModel::kDeterministic) {
+    if constexpr (Opacity::kBlends) {
       std::sort(translucent_.begin(), translucent_.end(), [](const auto& a, const auto& b) {
         return a.t < b.t || (a.t == b.t && a.id < b.id);
       });
@@ -173,4 +174,5 @@ class Integrator {
   std::vector<TranslucentHit> translucent_;
 };
 
+AMALGAM_ISA_END
 }  // namespace amalgam

@@ -13,10 +13,12 @@
 #include <cstdint>
 #include <vector>
 
+#include "amalgam/util/isa.h"
 #include "amalgam/math/random.h"
 #include "amalgam/render/render.h"
 
 namespace amalgam {
+AMALGAM_ISA_BEGIN
 
 /// Adds samples st.spp_done .. o.spp - 1 to `st` (sized for o.width x o.height), in passes of
 /// whole samples per pixel over 8x8 tiles on o.threads threads (0: all). Pixel (x, y),
@@ -93,4 +95,5 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
   return false;
 }
 
+AMALGAM_ISA_END
 }  // namespace amalgam

@@ -3,38 +3,10 @@
 #include <chrono>
 #include <type_traits>
 
-#include "amalgam/render/integrator.h"
-#include "amalgam/render/passes.h"
+#include "amalgam/render/render_isa.h"
+#include "amalgam/util/isa.h"
 
 namespace amalgam {
-namespace {
-
-/// Calls f(hierarchy, lod, opacity_constant, sorted_constant) with the policies the options
-/// select: the one place where run-time options become template arguments.
-template <class F>
-auto dispatch(const LoadedScene& scene, const RenderOptions& o, F&& f) {
-  return std::visit(
-      [&](const auto& h) {
-        auto with_lod = [&](auto lod) {
-          auto with_opacity = [&](auto op) {
-            if (o.sorted) return f(h, lod, op, std::true_type{});
-            return f(h, lod, op, std::false_type{});
-          };
-          if (o.opacity == OpacityKind::kStochastic)
-            return with_opacity(std::integral_constant<OpacityModel, OpacityModel::kStochastic>{});
-          return with_opacity(std::integral_constant<OpacityModel, OpacityModel::kDeterministic>{});
-        };
-        if (o.renderer == RendererKind::kTraditional) return with_lod(TraditionalLod{});
-        if (o.level) return with_lod(FixedLevelLod{*o.level});
-        return with_lod(FootprintLod{o.footprint});
-      },
-      scene.hierarchy);
-}
-
-template <class H, class Lod, class Op, class Sorted>
-using IntegratorFor = Integrator<H, Lod, Op::value, Sorted::value>;
-
-}  // namespace
 
 void check_options(const LoadedScene& scene, const RenderOptions& o) {
   const int levels = scene.info().levels;
@@ -81,13 +53,9 @@ RenderOutput render(const LoadedScene& scene, const RenderOptions& o, FilmState*
       st.spp_done > o.spp)
     throw InputError("resume: the saved render does not match these options");
 
-  bool interrupted = false;
-  dispatch(scene, o, [&](const auto& h, auto lod, auto op, auto sorted) {
-    using H = std::decay_t<decltype(h)>;
-    using I = IntegratorFor<H, decltype(lod), decltype(op), decltype(sorted)>;
-    interrupted = render_passes(scene.env.camera, o, st, control,
-                                [&](Counters& c) { return I(h, scene.env, lod, c); });
-  });
+  const bool interrupted = active_simd() == Simd::kAvx2
+                               ? detail::render_passes_avx2(scene, o, st, control)
+                               : detail::render_passes_portable(scene, o, st, control);
   RenderOutput out = finish(st);
   out.interrupted = interrupted;
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -97,14 +65,10 @@ RenderOutput render(const LoadedScene& scene, const RenderOptions& o, FilmState*
 TraceOutput trace(const LoadedScene& scene, const RenderOptions& o, const Ray& ray) {
   check_options(scene, o);
   TraceOutput out;
-  dispatch(scene, o, [&](const auto& h, auto lod, auto op, auto sorted) {
-    using H = std::decay_t<decltype(h)>;
-    IntegratorFor<H, decltype(lod), decltype(op), decltype(sorted)> integrator(h, scene.env, lod,
-                                                                               out.counters);
-    const SampleResult r = integrator.li(ray, hash_combine(hash_combine(o.seed, 0), 0));
-    out.hit = r.hit;
-    out.colour = r.colour;
-  });
+  if (active_simd() == Simd::kAvx2)
+    detail::trace_avx2(scene, o, ray, out);
+  else
+    detail::trace_portable(scene, o, ray, out);
   out.per_primary.add(out.counters.total());
   return out;
 }

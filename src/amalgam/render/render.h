@@ -9,7 +9,7 @@
 #include "amalgam/render/loaded_scene.h"
 #include "amalgam/stats/counters.h"
 #include "amalgam/stats/distribution.h"
-#include "amalgam/traverse/traverse.h"
+#include "amalgam/traverse/hit.h"
 
 namespace amalgam {
 

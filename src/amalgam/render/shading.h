@@ -3,9 +3,11 @@
 
 #include <numbers>
 
+#include "amalgam/util/isa.h"
 #include "amalgam/scene/scene.h"
 
 namespace amalgam {
+AMALGAM_ISA_BEGIN
 
 /// Reflected radiance factor for light arriving from `wi`, seen from `wo` (both unit, pointing
 /// away from the surface), with shading normal `n`.
@@ -22,4 +24,5 @@ inline Vec3 brdf(const Surface& s, Vec3 n, Vec3 wi, Vec3 wo) {
   return f;
 }
 
+AMALGAM_ISA_END
 }  // namespace amalgam

@@ -1,0 +1,63 @@
+// The per-instruction-set part of render() and trace(): the one place where run-time options
+// become template arguments. Included once per instruction set (render_portable.cpp,
+// render_avx2.cpp); see util/isa.h.
+
+#include <type_traits>
+
+#include "amalgam/render/integrator.h"
+#include "amalgam/render/passes.h"
+#include "amalgam/render/render_isa.h"
+
+namespace amalgam {
+AMALGAM_ISA_BEGIN
+namespace {
+
+/// Calls f(hierarchy, lod, opacity, order) with the policies the options select.
+template <class F>
+auto dispatch(const LoadedScene& scene, const RenderOptions& o, F&& f) {
+  return std::visit(
+      [&](const auto& h) {
+        auto with_lod = [&](auto lod) {
+          auto with_opacity = [&](auto op) {
+            if (o.sorted) return f(h, lod, op, SortedOrder{});
+            return f(h, lod, op, StoredOrder{});
+          };
+          if (o.opacity == OpacityKind::kStochastic) return with_opacity(StochasticOpacity{});
+          return with_opacity(DeterministicOpacity{});
+        };
+        if (o.renderer == RendererKind::kTraditional) return with_lod(TraditionalLod{});
+        if (o.level) return with_lod(FixedLevelLod{*o.level});
+        return with_lod(FootprintLod{o.footprint});
+      },
+      scene.hierarchy);
+}
+
+}  // namespace
+AMALGAM_ISA_END
+
+namespace detail {
+
+bool AMALGAM_ISA_SUFFIXED(render_passes)(const LoadedScene& scene, const RenderOptions& o,
+                                         FilmState& st, const RenderControl& control) {
+  bool interrupted = false;
+  dispatch(scene, o, [&](const auto& h, auto lod, auto op, auto order) {
+    using I = Integrator<std::decay_t<decltype(h)>, decltype(lod), decltype(op), decltype(order)>;
+    interrupted = render_passes(scene.env.camera, o, st, control,
+                                [&](Counters& c) { return I(h, scene.env, lod, c); });
+  });
+  return interrupted;
+}
+
+void AMALGAM_ISA_SUFFIXED(trace)(const LoadedScene& scene, const RenderOptions& o, const Ray& ray,
+                                 TraceOutput& out) {
+  dispatch(scene, o, [&](const auto& h, auto lod, auto op, auto order) {
+    using I = Integrator<std::decay_t<decltype(h)>, decltype(lod), decltype(op), decltype(order)>;
+    I integrator(h, scene.env, lod, out.counters);
+    const SampleResult r = integrator.li(ray, hash_combine(hash_combine(o.seed, 0), 0));
+    out.hit = r.hit;
+    out.colour = r.colour;
+  });
+}
+
+}  // namespace detail
+}  // namespace amalgam

@@ -1,0 +1,128 @@
+#pragma once
+/// \file The state every traversal algorithm shares while it traces one ray, and the rules
+/// applied when a ray meets a primitive or renders an amalgam, written once for all of them
+/// (generic_walk.h, wide_walk.h, gathered_walk.h, and the scalar reference, reference.h).
+///
+/// Cost accounting follows the paper: every bounding volume, amalgam and primitive a ray is
+/// tested against counts once, on the level of the object tested (root = level 0); a node is
+/// counted as an amalgam on the levels where the LOD policy may render, else as a bounding
+/// volume.
+
+#include <type_traits>
+#include <vector>
+
+#include "amalgam/geometry/intersect.h"
+#include "amalgam/hierarchy/hierarchy.h"
+#include "amalgam/stats/counters.h"
+#include "amalgam/traverse/hit.h"
+#include "amalgam/traverse/lod.h"
+#include "amalgam/traverse/opacity.h"
+#include "amalgam/util/isa.h"
+
+namespace amalgam {
+AMALGAM_ISA_BEGIN
+
+/// One traversal's state: the hierarchy and policies it runs with, and the ray in flight.
+/// `Stats` is Counters (exact counts) or NullCounters (counting compiled out).
+template <Hierarchy H, class Lod, class Opacity, class Stats>
+struct RayState {
+  RayState(const H& hierarchy, const Lod& l, Stats& c) : h(hierarchy), lod(l), counters(c) {}
+
+  /// Whether the LOD policy can ever render (TraditionalLod never does: no box is needed
+  /// after a node's own test).
+  static constexpr bool kMayRender = !std::is_same_v<Lod, TraditionalLod>;
+
+  const H& h;
+  Lod lod;
+  Opacity opacity;
+  Stats& counters;
+
+  Ray ray;
+  std::uint64_t key = 0;  ///< seeds this ray's stochastic decisions
+  RayKind kind = RayKind::kPrimary;
+  bool any_hit = false;  ///< a shadow ray: stop at the first opaque thing met
+  bool done = false;     ///< nothing further can change the result
+  TraceHit hit;
+  float transmittance = 1.0f;
+  std::vector<TranslucentHit>* translucent = nullptr;
+  /// `hit` is a triangle whose SurfaceHit is not built yet (`cand` holds its test's values):
+  /// the fast paths build it once, for the final closest hit only.
+  bool pending = false;
+  TriangleCandidate cand{};
+
+  void start(const Ray& r, std::uint64_t k, RayKind rk, bool shadow) {
+    ray = r;
+    key = k;
+    kind = rk;
+    any_hit = shadow;
+    done = false;
+    pending = false;
+    hit = TraceHit{};
+    transmittance = 1.0f;
+    counters.count_ray(rk);
+  }
+
+  ObjectKind object_kind(int level) const {
+    return lod.may_render(level) ? ObjectKind::kAmalgam : ObjectKind::kBoundingVolume;
+  }
+
+  /// The LOD policy's answer for a node on `level` with box `b`, entered at `t`: render it
+  /// (true) or descend. A node that contains the ray's origin (the ray starts inside it) is
+  /// flagged to the policy as such.
+  bool renders(const Bbox& b, int level, float t) const {
+    return lod.may_render(level) &&
+           lod.render(b, level, ray, t, t <= ray.tmin && b.contains(ray.origin));
+  }
+
+  /// A shadow ray met something opaque.
+  void occlude() {
+    transmittance = 0.0f;
+    done = true;
+  }
+
+  /// Primitive `id` (on `level`) hit at `s`.
+  void on_primitive(PrimId id, int level, const SurfaceHit& s) {
+    if (any_hit) return occlude();
+    ray.tmax = s.t;
+    pending = false;
+    hit = TraceHit{TraceHit::Kind::kPrimitive, s.t, id, level, s};
+  }
+
+  /// Triangle `id` hit with the test's values `c`; its SurfaceHit is built later.
+  void on_triangle(PrimId id, int level, const TriangleCandidate& c) {
+    if (any_hit) return occlude();
+    ray.tmax = c.t;
+    hit.kind = TraceHit::Kind::kPrimitive;
+    hit.t = c.t;
+    hit.id = id;
+    hit.level = level;
+    pending = true;
+    cand = c;
+  }
+
+  /// The LOD policy renders amalgam `id` (box `b`, entered at `t`): the opacity model decides
+  /// what that does to the ray, with the amalgam's opacity in the ray's direction.
+  void render_amalgam(NodeId id, int level, const Bbox& b, float t) {
+    const float a = directional_opacity(h.appearance(id), b, ray.dir);
+    switch (opacity.effect(a, key, id)) {
+      case AmalgamEffect::kPass:
+        return;
+      case AmalgamEffect::kBlend:
+        if (any_hit) {
+          transmittance *= 1.0f - a;
+        } else if (translucent) {
+          translucent->push_back({t, id, level, box_entry_hit(ray, b, t), a});
+        }
+        return;
+      case AmalgamEffect::kStop:
+        if (any_hit) return occlude();
+        ray.tmax = t;
+        pending = false;
+        hit = TraceHit{TraceHit::Kind::kAmalgam, t, id, level, box_entry_hit(ray, b, t)};
+        return;
+    }
+  }
+};
+
+AMALGAM_ISA_END
+}  // namespace amalgam

@@ -1,0 +1,196 @@
+#pragma once
+/// \file The fast traversal of an explicit hierarchy (sorted order): iterative with an
+/// explicit stack, all children of a node tested at once from their SoA boxes
+/// (hierarchy/wide.h, geometry/wide_kernels.h), and the triangles of a triangle-only leaf four
+/// at a time from SoA packs: the same hits and counts as the generic walk
+/// (tests/traverse/simd_test.cpp checks it against the scalar reference).
+///
+/// Speed (docs/benchmarks.md, "Profiling and optimisation"): per ray, the watertight triangle
+/// setup is done once and a primitive hit's SurfaceHit is built only for the final closest hit;
+/// a node's box is fetched again only when the LOD policy may render on its level.
+
+#include <algorithm>
+#include <bit>
+#include <concepts>
+#include <vector>
+
+#include "amalgam/geometry/wide_kernels.h"
+#include "amalgam/hierarchy/wide.h"
+#include "amalgam/traverse/state.h"
+
+namespace amalgam {
+
+/// A hierarchy with SoA child boxes (hierarchy/wide.h) and directly addressable primitives:
+/// the traversal's fast path. `wide_nodes()` returns null when they are not built.
+template <class H>
+concept WideHierarchy = requires(const H& h, std::size_t i) {
+  { h.wide_nodes() } -> std::same_as<const WideNodes*>;
+  { h.prims[i] } -> std::convertible_to<const Primitive&>;
+};
+
+AMALGAM_ISA_BEGIN
+
+template <class State>
+class WideWalk {
+ public:
+  /// Traces `s.ray` from the root (its box met at `t_root`).
+  void run(State& s, const WideNodes& w, std::uint32_t root, float t_root) {
+    if (stack_.size() < 64) stack_.resize(64);
+    stack_[0] = {t_root, root, 0};
+    // A ray with a zero direction component needs the box test's containment branch per
+    // axis; all others (nearly every ray) run a loop without those branches.
+    if (s.ray.dir.x == 0.0f || s.ray.dir.y == 0.0f || s.ray.dir.z == 0.0f)
+      loop<true>(s, w);
+    else
+      loop<false>(s, w);
+  }
+
+  /// Builds the SurfaceHit of the closest hit when it is a deferred triangle.
+  static void finish(State& s) {
+    const Primitive& p = s.h.prims[s.hit.id];
+    s.hit.surf = triangle_finish(s.ray, p.a, p.b, p.c, s.cand);
+    s.pending = false;
+  }
+
+ private:
+  struct StackItem {
+    float t;
+    std::uint32_t node;
+    int level;
+  };
+
+  /// Pushing a node's hit children farthest-first makes the pops the same depth-first,
+  /// nearest-first order as the recursion of the generic walk; a popped entry beyond the
+  /// closest hit is skipped, as the generic walk breaks there (every later sibling is farther
+  /// still). The stack is `stack_[0, sp)`, grown before a node's children are pushed.
+  template <bool kZeroAxes>
+  void loop(State& s, const WideNodes& w) {
+    // The per-ray constants and the stack's base and capacity as locals: members would be
+    // reloaded after every store to the stack (a float store may alias them).
+    const WideRay wr = WideRay::of(s.ray);
+    tri_ = wr.pre;  // for the primitives of mixed leaves (`primitive`)
+    StackItem* st = stack_.data();
+    std::size_t cap = stack_.size(), sp = 1;
+    while (sp > 0 && !s.done) {
+      const StackItem it = st[--sp];
+      if (it.t > s.ray.tmax) continue;
+      if constexpr (State::kMayRender) {
+        if (s.lod.may_render(it.level)) {
+          const Bbox b = s.h.bounds(it.node);
+          if (s.renders(b, it.level, it.t)) {
+            s.render_amalgam(it.node, it.level, b, it.t);
+            continue;
+          }
+        }
+      }
+      expand<kZeroAxes>(s, w, wr, it.node, it.level, st, cap, sp);
+    }
+  }
+
+  /// Always inlined into the pop loop: as a call per node it cost register saves and restores
+  /// and the box kernel's per-ray constants were set up again for every node (inlining it, with
+  /// the pushes straight onto the stack below, took the engine primary rays from 2 578 to
+  /// 2 133 instructions per ray; docs/benchmarks.md).
+  template <bool kZeroAxes>
+  [[gnu::always_inline]] void expand(State& s, const WideNodes& w, const WideRay& wr,
+                                     std::uint32_t node, int level, StackItem*& st,
+                                     std::size_t& cap, std::size_t& sp) {
+    const WideHeader hd = w.headers[node];
+    const int cl = level + 1;
+    const int count = hd.count;
+    if (hd.leaf == kWideTriangleLeaf) {
+      leaf_triangles(s, w, wr, hd, cl);
+      return;
+    }
+    if (hd.leaf) {
+      for (int i = 0; i < count; ++i) {
+        s.counters.count_test(s.kind, ObjectKind::kPrimitive, cl);
+        primitive(s, hd.first + static_cast<std::uint32_t>(i), cl);
+        if (s.done) return;
+      }
+      return;
+    }
+    const ObjectKind ok = s.object_kind(cl);
+    for (int i = 0; i < count; ++i) s.counters.count_test(s.kind, ok, cl);
+    if (sp + count > cap) {
+      stack_.resize(2 * cap + count);
+      st = stack_.data(), cap = stack_.size();
+    }
+    // The hit children go straight onto the stack, insertion-sorted farthest first (the
+    // nearest is popped first). A later child (stored order) goes below the hits with equal
+    // t, so that among equals the first in stored order is popped first, as the recursion
+    // enters them (stable sort).
+    const std::size_t base = sp;
+    auto collect = [&](unsigned mask, const float* t, int c0) {
+      for (; mask; mask &= mask - 1) {
+        const int lane = std::countr_zero(mask);
+        const float te = t[lane];  // never NaN: a NaN entry fails the kernel's t0 <= t1
+        std::size_t i = sp++;
+        while (i > base && st[i - 1].t <= te) st[i] = st[i - 1], --i;
+        st[i] = {te, hd.first + static_cast<std::uint32_t>(c0 + lane), cl};
+      }
+    };
+    const WideBox4* blk = w.blocks.data() + hd.block;
+    int c0 = 0;
+#if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
+    for (; count - c0 > kWideLanes; c0 += 2 * kWideLanes, blk += 2) {
+      alignas(32) float t[2 * kWideLanes];
+      const int m = std::min(count - c0, 2 * kWideLanes);
+      collect(intersect_wide8<kZeroAxes>(blk[0], blk[1], wr, s.ray.tmin, s.ray.tmax, m, t), t,
+              c0);
+    }
+#endif
+    for (; c0 < count; c0 += kWideLanes, ++blk) {
+      alignas(16) float t[kWideLanes];
+      const int m = std::min(count - c0, kWideLanes);
+      collect(intersect_wide4<kZeroAxes>(*blk, wr, s.ray.tmin, s.ray.tmax, m, t), t, c0);
+    }
+  }
+
+  /// A triangle-only leaf, four triangles at a time (`triangle_test4`), with the results and
+  /// counts of the one-by-one loop: there, a triangle is tested against the tmax left by the
+  /// hits before it, so of the lanes hit (all tested against the same tmax) a lane is taken in
+  /// leaf order when its t is still <= tmax (ties: the later one, as there); a shadow ray stops
+  /// at the first hit in leaf order, having tested the triangles up to and including it.
+  static void leaf_triangles(State& s, const WideNodes& w, const WideRay& wr,
+                             const WideHeader& hd, int level) {
+    const TrianglePack4* pack = w.tris.data() + hd.block;
+    const int count = hd.count;
+    for (int c0 = 0; c0 < count; c0 += kWideLanes, ++pack) {
+      const int m = std::min(count - c0, kWideLanes);
+      TrianglePackHits c;
+      unsigned mask = triangle_test4(*pack, wr, s.ray.tmin, s.ray.tmax, m, c);
+      if (s.any_hit && mask) {
+        const int tested = std::countr_zero(mask) + 1;
+        for (int i = 0; i < tested; ++i)
+          s.counters.count_test(s.kind, ObjectKind::kPrimitive, level);
+        s.occlude();
+        return;
+      }
+      for (int i = 0; i < m; ++i) s.counters.count_test(s.kind, ObjectKind::kPrimitive, level);
+      for (; mask; mask &= mask - 1) {
+        const int lane = std::countr_zero(mask);
+        if (!(c.t[lane] <= s.ray.tmax)) continue;  // an earlier lane hit closer
+        s.on_triangle(hd.first + static_cast<std::uint32_t>(c0 + lane), level, c.lane(lane));
+      }
+    }
+  }
+
+  /// One primitive of a mixed leaf: triangles with the per-ray setup and a deferred
+  /// SurfaceHit; other kinds through the full kernel (as ExplicitHierarchy::intersect).
+  void primitive(State& s, std::uint32_t id, int level) {
+    const Primitive& p = s.h.prims[id];
+    if (p.kind == PrimKind::kTriangle) {
+      TriangleCandidate c;
+      if (triangle_test(s.ray, tri_, p.a, p.b, p.c, c)) s.on_triangle(id, level, c);
+      return;
+    }
+    if (auto hit = amalgam::intersect(p, s.ray)) s.on_primitive(id, level, *hit);
+  }
+
+  std::vector<StackItem> stack_;
+  TrianglePre tri_{};
+};
+
+AMALGAM_ISA_END
+}  // namespace amalgam
