@@ -2,9 +2,15 @@
 
 #include <cmath>
 
+#include "amalgam/util/check.h"
+
 namespace amalgam {
 
 PrismsHierarchy::PrismsHierarchy(const Config& c) : c_(c) {
+  AMALGAM_CHECK(c_.split >= 2 && c_.split * c_.split * c_.split <= kMaxChildren,
+                "PrismsHierarchy: split^3 children must fit kMaxChildren");
+  AMALGAM_CHECK(c_.leaf >= 1 && c_.leaf <= kMaxChildren, "PrismsHierarchy: leaf out of range");
+  AMALGAM_CHECK(c_.depth >= 1 && c_.depth < kMaxLevels, "PrismsHierarchy: depth out of range");
   double w = 2.0;
   for (int l = 0; l < c_.depth; ++l) {
     cell_[l] = static_cast<float>(w);

@@ -3,10 +3,13 @@
 #include <cmath>
 
 #include "amalgam/math/random.h"
+#include "amalgam/util/check.h"
 
 namespace amalgam {
 
 TubeHierarchy::TubeHierarchy(const Config& c) : c_(c) {
+  AMALGAM_CHECK(c_.n >= 2 && c_.n <= kMaxChildren, "TubeHierarchy: n must be in [2, kMaxChildren]");
+  AMALGAM_CHECK(c_.depth >= 1 && c_.depth < kMaxLevels, "TubeHierarchy: depth out of range");
   count_[0] = 1;
   for (int l = 1; l <= c_.depth; ++l) count_[l] = count_[l - 1] * static_cast<std::uint64_t>(c_.n);
   for (int l = 0; l <= c_.depth; ++l)

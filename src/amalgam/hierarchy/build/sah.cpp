@@ -10,6 +10,7 @@
 #include <numeric>
 
 #include "amalgam/hierarchy/hierarchy.h"
+#include "amalgam/util/check.h"
 
 namespace amalgam {
 
@@ -219,7 +220,7 @@ SahTree build_sah(std::span<const Bbox> boxes, const SahConfig& config) {
     t.depth = std::max<int>(t.depth, level);
     if (n.leaf) {
       t.nodes[q].first = static_cast<std::uint32_t>(t.order.size());
-      t.nodes[q].count = static_cast<std::uint16_t>(n.b);
+      t.nodes[q].count = checked_narrow<std::uint16_t>(n.b, "SAH leaf size");
       t.nodes[q].leaf = true;
       t.order.insert(t.order.end(), b.idx_.begin() + n.a, b.idx_.begin() + n.a + n.b);
       continue;
@@ -239,7 +240,7 @@ SahTree build_sah(std::span<const Bbox> boxes, const SahConfig& config) {
       kids.insert(kids.begin() + best + 1, open.b);
     }
     t.nodes[q].first = static_cast<std::uint32_t>(t.nodes.size());
-    t.nodes[q].count = static_cast<std::uint16_t>(kids.size());
+    t.nodes[q].count = checked_narrow<std::uint16_t>(kids.size(), "SAH node arity");
     t.nodes[q].leaf = false;
     for (std::uint32_t k : kids) {
       t.nodes.push_back({bin[k].box, 0, 0, true});
