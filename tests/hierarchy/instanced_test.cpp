@@ -161,7 +161,10 @@ TEST(Instanced, CountsAddUpAndLevelsRunThroughInstances) {
     const ExplicitNode& t = in.top_nodes[i];
     in.for_each_child(i, [&](Child c) {
       const Bbox b = in.bounds(c.id);
-      EXPECT_TRUE(b.lo.x >= t.bounds.lo.x && b.hi.y <= t.bounds.hi.y && b.hi.z <= t.bounds.hi.z);
+      for (int a = 0; a < 3; ++a) {
+        EXPECT_GE(b.lo[a], t.bounds.lo[a]) << "top node " << i << ", axis " << a;
+        EXPECT_LE(b.hi[a], t.bounds.hi[a]) << "top node " << i << ", axis " << a;
+      }
       return true;
     });
   }
@@ -182,10 +185,22 @@ TEST(Instanced, CountsAddUpAndLevelsRunThroughInstances) {
       EXPECT_EQ(c.by_level[static_cast<std::size_t>(in.levels)], 0u);  // nothing below l_max
     }
   }
-  // Top-level amalgams are baked from the instances: opaque-ish, coloured like the blobs.
+  // Top-level amalgams are baked from the instances: opaque-ish, coloured like the blobs (the
+  // root's colour is a weighted mean of the instance roots' colours, so it lies within their
+  // range on every channel).
   const Appearance root = in.appearance(in.root());
   EXPECT_GT(root.opacity, 0.05f);
   EXPECT_LE(root.opacity, 1.0f);
+  Vec3 lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+  for (std::size_t k = 0; k < in.instances.size(); ++k) {
+    const Vec3 c = in.appearance(InstancedHierarchy::id(k + 1, 0)).surface.colour;
+    lo = min(lo, c), hi = max(hi, c);
+  }
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_GE(root.surface.colour[a], lo[a] - 1e-5f) << "channel " << a;
+    EXPECT_LE(root.surface.colour[a], hi[a] + 1e-5f) << "channel " << a;
+  }
+  EXPECT_GT(luminance(root.surface.colour), 0.0f);
 }
 
 TEST(Instanced, SceneFileKeepsLargeMeshesInstanced) {

@@ -140,9 +140,9 @@ TEST(ClosedOrientation, TellsClosedOutwardInwardAndOpen) {
   for (const Primitive& t : closed_box({5, 0, 0}, {6, 1, 1})) two.push_back(t);
   two.push_back(Primitive::sphere({9, 0, 0}, 1));
   EXPECT_EQ(closed_orientation(two), 1);
-  if (std::filesystem::exists(kWusonPath)) {
-    EXPECT_NE(closed_orientation(import_mesh(kWusonPath).triangles), 0) << "Wuson.ply is closed";
-  }
+  // Wuson.ply comes with assimp-testmodels, which scripts/deps.sh installs: missing is a failure.
+  ASSERT_TRUE(std::filesystem::exists(kWusonPath)) << kWusonPath << " (assimp-testmodels)";
+  EXPECT_NE(closed_orientation(import_mesh(kWusonPath).triangles), 0) << "Wuson.ply is closed";
 }
 
 TEST(ClosedOrientation, FlatAmalgamsOfAClosedSurfacePointOutAndPassRaysFromBehind) {
