@@ -44,14 +44,6 @@ std::string errno_text(int err) {
   return std::error_code(err, std::generic_category()).message();
 }
 
-/// Collapses a (library-provided) message onto one line.
-std::string one_line(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s;
-}
-
 enum class Format { kPng, kPfm, kExr };
 
 Format image_format(const std::string& path) {
@@ -140,7 +132,7 @@ void write_atomically(const std::string& path, Body&& body) {
     body(tmp);
     tmp.commit(path);
   } catch (const std::exception& e) {
-    throw ImageIoError(path + ": " + one_line(e.what()));
+    throw ImageIoError(path + ": " + one_line(e.what(), std::string::npos));
   }
 }
 
@@ -534,7 +526,7 @@ std::vector<Vec3> read_image(const std::string& path, int& width, int& height) {
         return read_exr(path, width, height);
     }
   } catch (const std::exception& e) {
-    throw ImageIoError(path + ": " + one_line(e.what()));
+    throw ImageIoError(path + ": " + one_line(e.what(), std::string::npos));
   }
   throw ImageIoError(path + ": unknown image format");
 }

@@ -6,17 +6,19 @@
 /// failure the temporary is removed and an ImageIoError is thrown, so `path` is either left
 /// untouched or holds a complete file.
 
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "amalgam/math/vec.h"
+#include "amalgam/util/error.h"
 
 namespace amalgam {
 
 /// Thrown by every function here on failure. what() is one line naming the file and the reason.
-struct ImageIoError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+/// A RuntimeError (exit status 1): callers that read user-given images and want a bad one to
+/// count as bad input convert it to an InputError (as `amalgam compare` does).
+struct ImageIoError : RuntimeError {
+  using RuntimeError::RuntimeError;
 };
 
 /// Writes a width x height image; pixel (x, y) is linear_rgb[y * width + x], y = 0 the top row.

@@ -28,16 +28,11 @@
 namespace amalgam {
 namespace {
 
+/// Assimp's messages can span lines; the contract wants one line, kept whole (one_line).
+constexpr std::size_t kUncut = std::string::npos;
+
 [[noreturn]] void fail(const std::string& path, const std::string& problem) {
   throw InputError(path + ": " + problem);
-}
-
-/// Assimp's messages can span lines; the contract wants one line.
-std::string one_line(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s;
 }
 
 /// Collects Assimp's warnings and errors instead of printing them.
@@ -51,8 +46,8 @@ class CaptureLogger : public Assimp::Logger {
   void OnDebug(const char*) override {}
   void OnVerboseDebug(const char*) override {}
   void OnInfo(const char*) override {}
-  void OnWarn(const char* m) override { warnings.push_back(one_line(m)); }
-  void OnError(const char* m) override { errors.push_back(one_line(m)); }
+  void OnWarn(const char* m) override { warnings.push_back(one_line(m, kUncut)); }
+  void OnError(const char* m) override { errors.push_back(one_line(m, kUncut)); }
 };
 
 /// Log messages by which Assimp reports that it dropped or replaced corrupt data. Other
@@ -198,7 +193,7 @@ ImportedMesh import_here(const std::string& path, const ImportConfig& config) {
   } catch (const std::bad_alloc&) {
     fail(path, "the importer ran out of memory (is the file corrupt?)");
   } catch (const std::exception& e) {
-    fail(path, "cannot import: " + one_line(e.what()));
+    fail(path, "cannot import: " + one_line(e.what(), kUncut));
   }
   // Assimp repairs some corrupt data with no more than a log message, and fails on other
   // corrupt data with a message about the consequence ("No meshes remaining"): name the cause.
@@ -207,7 +202,7 @@ ImportedMesh import_here(const std::string& path, const ImportConfig& config) {
       for (const char* pattern : kCorruptionMessages)
         if (m.find(pattern) != std::string::npos) fail(path, "corrupt data: " + m);
   if (scene == nullptr) {
-    std::string why = one_line(importer.GetErrorString());
+    std::string why = one_line(importer.GetErrorString(), kUncut);
     if (why.empty() && !logger->errors.empty()) why = logger->errors.front();
     fail(path, "cannot import: " + (why.empty() ? std::string("unknown error") : why));
   }
@@ -236,7 +231,7 @@ ImportedMesh import_here(const std::string& path, const ImportConfig& config) {
     if (m == nullptr || !(m->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || m->mVertices == nullptr)
       continue;
     const std::string where = "mesh " + std::to_string(mi) +
-                              (m->mName.length ? " ('" + one_line(m->mName.C_Str()) + "')" : "");
+                              (m->mName.length ? " ('" + one_line(m->mName.C_Str(), kUncut) + "')" : "");
     for (unsigned v = 0; v < m->mNumVertices; ++v) {
       const aiVector3D& p = m->mVertices[v];
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
