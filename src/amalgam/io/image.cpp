@@ -12,9 +12,10 @@
 #include <png.h>
 #include <unistd.h>
 
+#include "amalgam/util/atomic_file.h"
+
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
 #include <cctype>
 #include <cerrno>
@@ -72,70 +73,6 @@ std::uint8_t encode_srgb8(float v) {
   return static_cast<std::uint8_t>(std::lround(linear_to_srgb(v) * 255.0));
 }
 
-// ---- atomic output -------------------------------------------------------------------------
-
-/// A temporary file next to the destination. The destructor closes it and, unless commit()
-/// succeeded, removes it.
-class TempFile {
- public:
-  explicit TempFile(const std::string& target)
-      : path_(target + ".tmp-" + std::to_string(::getpid()) + "-" +
-              std::to_string(counter_.fetch_add(1))) {
-    fp_ = std::fopen(path_.c_str(), "wb");
-    if (!fp_) throw Failure("cannot open for writing: " + errno_text(errno));
-  }
-  TempFile(const TempFile&) = delete;
-  TempFile& operator=(const TempFile&) = delete;
-  ~TempFile() {
-    if (fp_) std::fclose(fp_);
-    if (!committed_) {
-      std::error_code ec;
-      fs::remove(path_, ec);
-    }
-  }
-
-  std::FILE* get() const { return fp_; }
-  const std::string& path() const { return path_; }
-
-  void write(const void* data, std::size_t n) {
-    if (n != 0 && std::fwrite(data, 1, n, fp_) != n)
-      throw Failure("write failed: " + errno_text(errno));
-  }
-
-  /// Flushes, syncs and closes the file, then renames it onto target.
-  void commit(const std::string& target) {
-    if (std::fflush(fp_) != 0) throw Failure("write failed: " + errno_text(errno));
-    if (std::ferror(fp_)) throw Failure("write failed");
-    if (::fsync(::fileno(fp_)) != 0) throw Failure("cannot sync to disk: " + errno_text(errno));
-    std::FILE* fp = fp_;
-    fp_ = nullptr;
-    if (std::fclose(fp) != 0) throw Failure("write failed on close: " + errno_text(errno));
-    std::error_code ec;
-    fs::rename(path_, target, ec);
-    if (ec) throw Failure("cannot rename temporary file into place: " + ec.message());
-    committed_ = true;
-  }
-
- private:
-  static inline std::atomic<unsigned long> counter_{0};
-  std::string path_;
-  std::FILE* fp_ = nullptr;
-  bool committed_ = false;
-};
-
-/// Runs body(TempFile&) and commits; any failure removes the temporary and becomes an
-/// ImageIoError naming path.
-template <class Body>
-void write_atomically(const std::string& path, Body&& body) {
-  try {
-    TempFile tmp(path);
-    body(tmp);
-    tmp.commit(path);
-  } catch (const std::exception& e) {
-    throw ImageIoError(path + ": " + one_line(e.what(), std::string::npos));
-  }
-}
-
 using FilePtr = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
 
 FilePtr open_for_reading(const std::string& path) {
@@ -188,7 +125,7 @@ bool png_write_rgb8(std::FILE* fp, int width, int height, const std::uint8_t* rg
   return true;
 }
 
-void write_png(TempFile& out, int width, int height, const std::vector<Vec3>& pixels) {
+void write_png(AtomicFile& out, int width, int height, const std::vector<Vec3>& pixels) {
   std::vector<std::uint8_t> rgb(pixels.size() * 3);
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     rgb[3 * i + 0] = encode_srgb8(pixels[i].x);
@@ -196,7 +133,7 @@ void write_png(TempFile& out, int width, int height, const std::vector<Vec3>& pi
     rgb[3 * i + 2] = encode_srgb8(pixels[i].z);
   }
   PngErrorState err;
-  if (!png_write_rgb8(out.get(), width, height, rgb.data(), err))
+  if (!png_write_rgb8(out.stream(), width, height, rgb.data(), err))
     throw Failure(std::string("PNG encoding failed: ") + err.message);
 }
 
@@ -296,7 +233,7 @@ std::uint32_t byte_swap(std::uint32_t v) {
   return (v >> 24) | ((v >> 8) & 0xff00u) | ((v << 8) & 0xff0000u) | (v << 24);
 }
 
-void write_pfm(TempFile& out, int width, int height, const std::vector<Vec3>& pixels) {
+void write_pfm(AtomicFile& out, int width, int height, const std::vector<Vec3>& pixels) {
   const std::string header =
       "PF\n" + std::to_string(width) + " " + std::to_string(height) + "\n-1.0\n";
   out.write(header.data(), header.size());
@@ -411,7 +348,7 @@ class StdioOStream final : public Imf::OStream {
   std::string error_;
 };
 
-void write_exr(TempFile& out, int width, int height, const std::vector<Vec3>& pixels) {
+void write_exr(AtomicFile& out, int width, int height, const std::vector<Vec3>& pixels) {
   constexpr float kHalfMax = 65504.0f;
   const auto to_half = [&](float v) {
     return half(std::isfinite(v) ? std::clamp(v, -kHalfMax, kHalfMax) : v);
@@ -420,7 +357,7 @@ void write_exr(TempFile& out, int width, int height, const std::vector<Vec3>& pi
   for (std::size_t i = 0; i < pixels.size(); ++i)
     rgba[i] =
         Imf::Rgba(to_half(pixels[i].x), to_half(pixels[i].y), to_half(pixels[i].z), half(1.0f));
-  StdioOStream stream(out.get(), out.path().c_str());
+  StdioOStream stream(out.stream(), out.temp_path().c_str());
   {
     Imf::Header header(width, height);
     Imf::RgbaOutputFile file(stream, header, Imf::WRITE_RGB);
@@ -499,7 +436,7 @@ void write_image(const std::string& path, int width, int height,
   if (linear_rgb.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height))
     throw ImageIoError(path + ": " + std::to_string(linear_rgb.size()) + " pixels given for a " +
                        std::to_string(width) + "x" + std::to_string(height) + " image");
-  write_atomically(path, [&](TempFile& out) {
+  write_atomically<ImageIoError>(path, [&](AtomicFile& out) {
     switch (format) {
       case Format::kPng:
         write_png(out, width, height, linear_rgb);
@@ -551,10 +488,6 @@ std::vector<Vec3> false_colour(const std::vector<double>& values, bool log_scale
   }
   if (vmax_out) *vmax_out = vmax;
   return colours;
-}
-
-void write_text_atomic(const std::string& path, const std::string& contents) {
-  write_atomically(path, [&](TempFile& out) { out.write(contents.data(), contents.size()); });
 }
 
 }  // namespace amalgam

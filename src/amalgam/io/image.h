@@ -1,10 +1,8 @@
 #pragma once
 /// \file Image and text output (PNG, PFM, OpenEXR), image input, and false-colour mapping.
 ///
-/// All writers are atomic: data goes to a temporary file in the destination directory
-/// (`<path>.tmp-<pid>-<n>`), which is flushed, synced and then renamed onto `path`. On any
-/// failure the temporary is removed and an ImageIoError is thrown, so `path` is either left
-/// untouched or holds a complete file.
+/// Writing is atomic (util/atomic_file.h): on any failure an ImageIoError is thrown and `path`
+/// is either left untouched or holds a complete file.
 
 #include <string>
 #include <vector>
@@ -44,8 +42,5 @@ std::vector<Vec3> read_image(const std::string& path, int& width, int& height);
 /// Writes that largest finite value (0 if no value is positive) to *vmax_out when not null.
 std::vector<Vec3> false_colour(const std::vector<double>& values, bool log_scale,
                                double* vmax_out = nullptr);
-
-/// Writes `contents` to `path` with the same temporary-file-and-rename rule as write_image.
-void write_text_atomic(const std::string& path, const std::string& contents);
 
 }  // namespace amalgam
