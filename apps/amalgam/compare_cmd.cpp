@@ -8,6 +8,7 @@
 #include <string>
 
 #include "amalgam/builtin/params.h"
+#include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
 #include "amalgam/io/metrics.h"
 #include "common.h"

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "amalgam/io/checkpoint.h"
+#include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
 #include "amalgam/io/stats_json.h"
 #include "amalgam/load/load_scene.h"

@@ -1,5 +1,6 @@
 #pragma once
-/// \file Image and text output (PNG, PFM, OpenEXR), image input, and false-colour mapping.
+/// \file Image files: writing (PNG, PFM, OpenEXR) and reading, by extension. The codecs are
+/// png.h, pfm.h and exr.h; false colour is colormap.h.
 ///
 /// Writing is atomic (util/atomic_file.h): on any failure an ImageIoError is thrown and `path`
 /// is either left untouched or holds a complete file.
@@ -34,13 +35,5 @@ void write_image(const std::string& path, int width, int height,
 /// height and returns pixels in the same layout write_image takes. Throws ImageIoError naming
 /// the file on any error.
 std::vector<Vec3> read_image(const std::string& path, int& width, int& height);
-
-/// Maps non-negative values (e.g. intersection tests per pixel) to the viridis colour map, in
-/// linear RGB (so write_image's sRGB encoding displays the published colours). Values are
-/// normalised by the largest finite value, after log1p when log_scale is set; negative and NaN
-/// values map to the low end, +inf to the high end. Luminance increases with the value.
-/// Writes that largest finite value (0 if no value is positive) to *vmax_out when not null.
-std::vector<Vec3> false_colour(const std::vector<double>& values, bool log_scale,
-                               double* vmax_out = nullptr);
 
 }  // namespace amalgam
