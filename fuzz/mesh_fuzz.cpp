@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <string>
 
-#include "amalgam/io/scene_file.h"
+#include "amalgam/load/load_scene.h"
 #include "fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
