@@ -4,8 +4,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "amalgam/builtin/params.h"
 #include "amalgam/util/atomic_file.h"
+#include "amalgam/util/error.h"
 
 namespace amalgam {
 namespace {
