@@ -36,7 +36,7 @@ AtomicFile::AtomicFile(const std::string& destination)
     : destination_(destination),
       temp_(destination + ".tmp-" + std::to_string(::getpid()) + "-" +
             std::to_string(g_counter.fetch_add(1))) {
-  fp_ = std::fopen(temp_.c_str(), "wbx");  // x: never follow or reuse an existing file
+  fp_ = std::fopen(temp_.c_str(), "wb");
   if (!fp_) throw RuntimeError("cannot open for writing: " + errno_text(errno));
 }
 
