@@ -51,7 +51,7 @@
 #include <vector>
 
 #include "amalgam/io/image.h"
-#include "amalgam/io/metrics.h"
+#include "amalgam/analysis/metrics.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/integrator.h"
 #include "amalgam/render/passes.h"

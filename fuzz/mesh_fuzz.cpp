@@ -10,7 +10,7 @@
 #include <string>
 
 #include "amalgam/hierarchy/build/build.h"
-#include "amalgam/io/scene_file.h"
+#include "amalgam/load/load_scene.h"
 #include "fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "amalgam/io/mesh_import.h"
-#include "amalgam/io/scene_file.h"
+#include "amalgam/io/scene_json.h"
 
 namespace amalgam {
 namespace {
@@ -47,7 +47,7 @@ struct TempFile {
 
 // scene_json_fuzz, crash-6cde37d7: a number beyond double's range made nlohmann::json throw
 // out_of_range (not parse_error), which escaped parse_scene_json: std::terminate.
-// Fixed in src/amalgam/io/scene_file.cpp (parse_scene_json catches it: describe_overflow).
+// Fixed in src/amalgam/io/json_reader.cpp (parse_json catches it: describe_overflow).
 TEST(FuzzRegression, SceneJsonNumberOverflow) {
   const std::string text = R"json({
   "comment": "Spheres on a ground slab: amalgam render scenes/spheres.json --out spheres.png",

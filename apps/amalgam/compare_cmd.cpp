@@ -8,8 +8,9 @@
 #include <string>
 
 #include "amalgam/builtin/params.h"
+#include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
-#include "amalgam/io/metrics.h"
+#include "amalgam/analysis/metrics.h"
 #include "common.h"
 
 namespace amalgam::cli {

@@ -6,11 +6,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 
 #include "amalgam/analysis/experiments.h"
+#include "amalgam/util/atomic_file.h"
 #include "common.h"
 
 namespace amalgam::cli {
@@ -18,18 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 namespace ex = amalgam::experiments;
-
-/// Writes `text` to `path` through a temporary file, so nothing half-written is left.
-void write_file(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    if (!f) throw std::runtime_error(tmp.string() + ": cannot open for writing");
-    f << text;
-    if (!f.flush()) throw std::runtime_error(tmp.string() + ": write failed");
-  }
-  fs::rename(tmp, path);
-}
 
 std::string csv(const ex::Table& t) {
   std::ostringstream o;
@@ -205,8 +193,8 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
   for (const std::string& n : todo) {
     std::cerr << "amalgam: experiment " << n << " ..." << std::flush;
     const ex::ExperimentResult r = ex::run(n, config);
-    write_file(dir / (n + ".csv"), csv(r.table));
-    write_file(dir / (n + ".gp"), gnuplot_script(r, n + ".csv", n + ".png.tmp"));
+    write_file_atomic((dir / (n + ".csv")).string(), csv(r.table));
+    write_file_atomic((dir / (n + ".gp")).string(), gnuplot_script(r, n + ".csv", n + ".png.tmp"));
     const bool plotted = gnuplot && plot(dir, n);
     int passed = 0;
     for (const auto& c : r.checks) passed += c.passed();
@@ -220,7 +208,7 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
     body << section(r, plotted, gnuplot);
   }
   report << "\n" << body.str();
-  write_file(dir / "report.md", report.str());
+  write_file_atomic((dir / "report.md").string(), report.str());
   std::cout << "report: " << (dir / "report.md").string() << "\n";
   (void)failures;
   return 0;

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <iostream>
 
-#include "amalgam/io/image.h"
+#include "amalgam/util/error.h"
 #include "common.h"
 
 int main(int argc, char** argv) {
@@ -83,14 +83,8 @@ int main(int argc, char** argv) {
     if (experiment->parsed()) return cli::run_experiment(exp_name, exp_out, exp_quick, exp_threads);
     if (compare->parsed()) return cli::run_compare(cmp);
     return cli::run_scenes();
-  } catch (const InputError& e) {
+  } catch (const std::exception& e) {  // the one place failures become exit statuses
     std::cerr << "amalgam: " << e.what() << "\n";
-    return 2;
-  } catch (const ImageIoError& e) {
-    std::cerr << "amalgam: " << e.what() << "\n";
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "amalgam: " << e.what() << "\n";
-    return 1;
+    return exit_status(e);
   }
 }

@@ -11,10 +11,12 @@
 #include <sstream>
 
 #include "amalgam/io/checkpoint.h"
+#include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
 #include "amalgam/io/stats_json.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
+#include "amalgam/util/atomic_file.h"
 #include "common.h"
 
 namespace amalgam::cli {
@@ -182,7 +184,7 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   if (extra.stats == "-")
     std::cout << json;
   else if (!extra.stats.empty())
-    write_text_atomic(extra.stats, json);
+    write_file_atomic(extra.stats, json);
 
   if (r.interrupted) {
     write_checkpoint(ckpt, fp, state);

@@ -1,8 +1,13 @@
 // Mesh import (Assimp), scene files (JSON) and how bad input of either kind is reported.
 
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -10,7 +15,6 @@
 #include <vector>
 
 #include "amalgam/io/mesh_import.h"
-#include "amalgam/load/load_scene.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
 
@@ -93,20 +97,130 @@ TEST(MeshImport, RealModelsLoadAndRender) {
   }
 }
 
-// Assimp runs in a child process: a crash inside it (here: the child aborts on purpose, as
-// Assimp 5.2 does on an assertion for some corrupt files) is one InputError naming the file,
-// and the process that asked carries on (the next import works).
+// Assimp runs in a helper process (amalgam-import): a crash inside it (here: a stand-in helper,
+// tests/io/fake_importer.cpp, aborts as Assimp 5.2 does on an assertion for some corrupt
+// files) is one InputError naming the file, and the process that asked carries on (the next
+// import, with the real helper, works).
 TEST(MeshImport, AnImporterCrashIsAnInputError) {
   REQUIRE_MODELS();
   const std::string path = (kModels / "PLY/Wuson.ply").string();
-  ::setenv("AMALGAM_TEST_IMPORTER_ABORT", "1", 1);
-  const std::string e = input_error([&] { (void)import_mesh(path); });
-  ::unsetenv("AMALGAM_TEST_IMPORTER_ABORT");
+  ImportConfig crashing;
+  crashing.helper = AMALGAM_FAKE_IMPORTER;
+  const std::string e = input_error([&] { (void)import_mesh(path, crashing); });
   EXPECT_EQ(e, path + ": the importer crashed on this file (signal 6); is it corrupt?");
   const ImportedMesh m = import_mesh(path);
   EXPECT_EQ(m.triangles.size(), 3732u);
   EXPECT_FALSE(m.materials.empty());
   EXPECT_FALSE(m.bounds.empty());
+}
+
+/// The message of the RuntimeError that `f` throws ("" and a test failure if it throws none).
+template <class F>
+std::string runtime_error(F&& f) {
+  try {
+    f();
+  } catch (const RuntimeError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no RuntimeError thrown";
+  return "";
+}
+
+// A helper that replies with more than it may, or in another protocol, is stopped (it would
+// wait forever) and reaped; a helper that cannot be started is a RuntimeError (exit status 1),
+// not bad input.
+TEST(MeshImport, AMisbehavingOrMissingHelperIsStoppedAndReported) {
+  const fs::path d = temp_dir("helper");
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  for (const char* name : {"too-many.obj", "other-protocol.obj"}) write_file(d / name, tri);
+  ImportConfig fake;
+  fake.helper = AMALGAM_FAKE_IMPORTER;
+  fake.max_triangles = 1;
+  const std::string too_many = (d / "too-many.obj").string();
+  EXPECT_EQ(input_error([&] { (void)import_mesh(too_many, fake); }),
+            too_many + ": the importer crashed on this file (signal 9); is it corrupt?");
+  const std::string other =
+      runtime_error([&] { (void)import_mesh((d / "other-protocol.obj").string(), fake); });
+  EXPECT_EQ(other.rfind(fake.helper + ": not the mesh importer of this build", 0), 0u) << other;
+  ImportConfig missing;
+  missing.helper = (d / "no-such-helper").string();
+  EXPECT_EQ(runtime_error([&] { (void)import_mesh(too_many, missing); }),
+            missing.helper + ": cannot start the mesh importer: No such file or directory");
+  // The environment variable names the helper when ImportConfig does not.
+  ::setenv("AMALGAM_IMPORT_HELPER", AMALGAM_FAKE_IMPORTER, 1);
+  const std::string e = input_error([&] { (void)import_mesh((d / "crash.obj").string()); });
+  ::unsetenv("AMALGAM_IMPORT_HELPER");
+  EXPECT_NE(e.find("no such file"), std::string::npos) << "checked before any helper: " << e;
+  write_file(d / "crash.obj", tri);
+  ::setenv("AMALGAM_IMPORT_HELPER", AMALGAM_FAKE_IMPORTER, 1);
+  const std::string c = input_error([&] { (void)import_mesh((d / "crash.obj").string()); });
+  ::unsetenv("AMALGAM_IMPORT_HELPER");
+  EXPECT_NE(c.find("the importer crashed on this file (signal 6)"), std::string::npos) << c;
+  EXPECT_EQ(import_mesh((d / "crash.obj").string()).triangles.size(), 1u);
+}
+
+/// The state letter of /proc/PID/stat ('S' sleeping, 'Z' zombie, ...), '?' once it is gone,
+/// and the command name in `comm`.
+char process_state(pid_t pid, std::string* comm = nullptr) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string id, name, state;
+  if (!(stat >> id >> name >> state)) return '?';
+  if (comm) *comm = name;
+  return state[0];
+}
+
+// The real helper dies with the process that started it, even one killed with SIGKILL (which
+// runs no clean-up). Here its parent is a shell, and it blocks opening a FIFO that nobody
+// writes (import_mesh only ever passes regular files; the helper is run by hand here).
+TEST(MeshImport, TheHelperDiesWithItsParent) {
+  const fs::path d = temp_dir("orphan");
+  const std::string fifo = (d / "never.obj").string(), pid_file = (d / "helper.pid").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::vector<std::string> args = {
+      "/bin/sh",
+      "-c",
+      "\"$0\" --parent $$ --max-triangles 10 -- \"$1\" & echo $! > \"$2\"; wait",
+      AMALGAM_IMPORT_HELPER,
+      fifo,
+      pid_file};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t shell = 0;
+  ASSERT_EQ(::posix_spawn(&shell, "/bin/sh", nullptr, nullptr, argv.data(), environ), 0);
+  pid_t helper = 0;
+  std::string comm;
+  for (int i = 0; i < 1000; ++i, ::usleep(10'000)) {
+    std::ifstream in(pid_file);
+    if (helper == 0 && !(in >> helper)) helper = 0;
+    if (helper != 0 && process_state(helper, &comm) == 'S' && comm == "(amalgam-import)") break;
+  }
+  ASSERT_GT(helper, 0) << "the helper did not start";
+  ASSERT_EQ(process_state(helper), 'S') << "the helper waits for the FIFO " << comm;
+  ::kill(shell, SIGKILL);
+  int status = 0;
+  ASSERT_EQ(::waitpid(shell, &status, 0), shell);
+  // Gone, or a zombie if nothing reaps orphans here, within a few seconds.
+  char state = 'S';
+  for (int i = 0; i < 500 && state != '?' && state != 'Z'; ++i, ::usleep(10'000))
+    state = process_state(helper);
+  EXPECT_TRUE(state == '?' || state == 'Z') << "helper " << helper << " outlived its parent";
+  if (state != '?' && state != 'Z') ::kill(helper, SIGKILL);
+}
+
+// Started with a --parent that is not its parent (it was orphaned before it could ask to die
+// with it), the helper stops at once, writing nothing.
+TEST(MeshImport, TheHelperStopsWhenItsParentIsAlreadyGone) {
+  REQUIRE_MODELS();
+  const std::string cmd = std::string(AMALGAM_IMPORT_HELPER) + " --parent 999999999 " +
+                          "--max-triangles 10 -- " + (kModels / "PLY/Wuson.ply").string() +
+                          " | wc -c";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  int bytes = -1;
+  EXPECT_EQ(std::fscanf(p, "%d", &bytes), 1);
+  ::pclose(p);
+  EXPECT_EQ(bytes, 0);
 }
 
 TEST(MeshImport, Gltf2BaseColours) {

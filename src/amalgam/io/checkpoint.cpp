@@ -4,8 +4,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "amalgam/builtin/params.h"
-#include "amalgam/io/image.h"
+#include "amalgam/util/atomic_file.h"
+#include "amalgam/util/error.h"
 
 namespace amalgam {
 namespace {
@@ -41,7 +41,7 @@ void write_checkpoint(const std::string& path, const std::string& fingerprint,
   st.per_primary.for_each([&](std::uint64_t, std::uint64_t) { ++distinct; });
   put(out, distinct);
   st.per_primary.for_each([&](std::uint64_t v, std::uint64_t c) { put(out, v), put(out, c); });
-  write_text_atomic(path, out.str());
+  write_file_atomic(path, out.str());
 }
 
 FilmState read_checkpoint(const std::string& path, const std::string& fingerprint) {

@@ -9,7 +9,7 @@
 
 namespace amalgam {
 
-/// Writes `state` atomically (temporary file + rename). Throws ImageIoError on failure.
+/// Writes `state` atomically (util/atomic_file.h). Throws RuntimeError on failure.
 void write_checkpoint(const std::string& path, const std::string& fingerprint,
                       const FilmState& state);
 

@@ -1,22 +1,23 @@
 #pragma once
-/// \file Image and text output (PNG, PFM, OpenEXR), image input, and false-colour mapping.
+/// \file Image files: writing (PNG, PFM, OpenEXR) and reading, by extension. The codecs are
+/// png.h, pfm.h and exr.h; false colour is colormap.h.
 ///
-/// All writers are atomic: data goes to a temporary file in the destination directory
-/// (`<path>.tmp-<pid>-<n>`), which is flushed, synced and then renamed onto `path`. On any
-/// failure the temporary is removed and an ImageIoError is thrown, so `path` is either left
-/// untouched or holds a complete file.
+/// Writing is atomic (util/atomic_file.h): on any failure an ImageIoError is thrown and `path`
+/// is either left untouched or holds a complete file.
 
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "amalgam/math/vec.h"
+#include "amalgam/util/error.h"
 
 namespace amalgam {
 
 /// Thrown by every function here on failure. what() is one line naming the file and the reason.
-struct ImageIoError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+/// A RuntimeError (exit status 1): callers that read user-given images and want a bad one to
+/// count as bad input convert it to an InputError (as `amalgam compare` does).
+struct ImageIoError : RuntimeError {
+  using RuntimeError::RuntimeError;
 };
 
 /// Writes a width x height image; pixel (x, y) is linear_rgb[y * width + x], y = 0 the top row.
@@ -34,16 +35,5 @@ void write_image(const std::string& path, int width, int height,
 /// height and returns pixels in the same layout write_image takes. Throws ImageIoError naming
 /// the file on any error.
 std::vector<Vec3> read_image(const std::string& path, int& width, int& height);
-
-/// Maps non-negative values (e.g. intersection tests per pixel) to the viridis colour map, in
-/// linear RGB (so write_image's sRGB encoding displays the published colours). Values are
-/// normalised by the largest finite value, after log1p when log_scale is set; negative and NaN
-/// values map to the low end, +inf to the high end. Luminance increases with the value.
-/// Writes that largest finite value (0 if no value is positive) to *vmax_out when not null.
-std::vector<Vec3> false_colour(const std::vector<double>& values, bool log_scale,
-                               double* vmax_out = nullptr);
-
-/// Writes `contents` to `path` with the same temporary-file-and-rename rule as write_image.
-void write_text_atomic(const std::string& path, const std::string& contents);
 
 }  // namespace amalgam

@@ -1,5 +1,11 @@
 #pragma once
 /// \file Reading triangle meshes with Assimp (OBJ, PLY, glTF 2, and whatever else it reads).
+///
+/// Assimp 5.2 aborts or crashes on some corrupt files that no header check catches (the fuzzer
+/// keeps finding them: tests/fuzz_regressions_test.cpp). So it never runs inside amalgam: each
+/// import starts the helper executable `amalgam-import` (apps/amalgam-import, installed next to
+/// `amalgam`) with posix_spawn, which is safe from a multi-threaded process, and reads the
+/// result from its stdout (io/import_protocol.h). A helper that dies is one InputError.
 
 #include <cstdint>
 #include <string>
@@ -23,6 +29,11 @@ struct ImportedMesh {
 struct ImportConfig {
   /// More triangles than this is an InputError (before any are copied).
   std::uint64_t max_triangles = 50'000'000;
+  /// The helper executable that runs Assimp. Empty: the environment variable
+  /// AMALGAM_IMPORT_HELPER if set and not empty, else `amalgam-import` in the directory of the
+  /// running executable (/proc/self/exe) if it is there, else the one of the build tree
+  /// (AMALGAM_IMPORT_HELPER_BUILD_PATH, compiled in).
+  std::string helper;
 };
 
 /// Imports the triangles of `path` with Assimp: faces triangulated, node transforms baked
@@ -30,8 +41,12 @@ struct ImportConfig {
 /// base colour factor (glTF 2 `baseColorFactor`) if present, else its diffuse colour; textures
 /// are ignored. Throws InputError, one line "<path>: <problem>", when Assimp cannot read the
 /// file, when it reports corrupt data it repaired (faces with out-of-range or missing indices,
-/// vertex counts that do not fit the primitive mode), when a vertex is NaN or infinite, or
-/// when no triangle with non-zero area is left. Never prints: Assimp's logger stays silent.
+/// vertex counts that do not fit the primitive mode), when a vertex is NaN or infinite, when
+/// no triangle with non-zero area is left, or when the importer crashes on it ("the importer
+/// crashed on this file (signal N); is it corrupt?"). Throws RuntimeError when the helper
+/// cannot be found or started, or is not a compatible build. Never prints: Assimp's logger
+/// stays silent and the helper's stderr goes to /dev/null. Thread-safe: concurrent imports
+/// run in separate helpers. A helper never outlives the process that started it.
 ImportedMesh import_mesh(const std::string& path, const ImportConfig& config = {});
 
 }  // namespace amalgam

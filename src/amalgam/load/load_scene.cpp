@@ -5,6 +5,10 @@
 #include <chrono>
 #include <filesystem>
 
+#include "amalgam/io/mesh_import.h"
+#include "amalgam/scene/coordinate_limit.h"
+#include "amalgam/scene/framing.h"
+
 namespace amalgam {
 
 AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config) {
@@ -21,6 +25,19 @@ AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config) {
     d.instances.push_back(loose);
   }
   return build_instanced(std::move(meshes), std::move(d.instances), config);
+}
+
+SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& config) {
+  ImportConfig ic;
+  ic.max_triangles = config.max_triangles;
+  ImportedMesh m = import_mesh(path, ic);
+  check_extent(m.bounds, path);
+  SceneDescription d;
+  d.prims = std::move(m.triangles);
+  d.materials = std::move(m.materials);
+  d.env.camera = frame_camera(m.bounds);
+  d.env.lights = default_lights(m.bounds, d.env.camera);
+  return d;
 }
 
 LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config) {

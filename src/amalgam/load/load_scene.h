@@ -7,7 +7,7 @@
 #include <string>
 
 #include "amalgam/hierarchy/build/build.h"
-#include "amalgam/io/scene_file.h"
+#include "amalgam/io/scene_json.h"
 #include "amalgam/render/loaded_scene.h"
 
 namespace amalgam {
@@ -15,6 +15,11 @@ namespace amalgam {
 /// The hierarchy of a described scene: explicit when it has no instances, else instanced,
 /// with the loose primitives as one more mesh placed once, untransformed.
 AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config = {});
+
+/// A bare mesh (see `import_mesh`, io/mesh_import.h) as a scene: its triangles and materials,
+/// with `frame_camera` and `default_lights` (scene/framing.h). Only `config.max_triangles`
+/// applies. Throws InputError naming the file.
+SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& config = {});
 
 /// Loads a scene path: `.json` (any case) as a scene file, anything else as a mesh; builds
 /// and bakes its hierarchy (build_hierarchy). Sets load_seconds (reading) and build_seconds.

@@ -34,20 +34,6 @@ Bbox bounds(const Primitive& prim) {
   return b;
 }
 
-float mean_projected_area(const Primitive& prim) {
-  switch (prim.kind) {
-    case PrimKind::kTriangle:
-      return 0.25f * length(cross(prim.b - prim.a, prim.c - prim.a));
-    case PrimKind::kSphere:
-      return std::numbers::pi_v<float> * prim.radius * prim.radius;
-    case PrimKind::kBox: {
-      const Vec3 e = prim.b - prim.a;
-      return 0.5f * (e.x * e.y + e.y * e.z + e.z * e.x);
-    }
-  }
-  return 0.0f;
-}
-
 Ray Camera::generate(float fx, float fy, int width, int height) const {
   const Vec3 w = normalize(look_at - position);
   const Vec3 u = normalize(cross(w, up));

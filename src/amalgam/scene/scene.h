@@ -44,9 +44,6 @@ struct Primitive {
 std::optional<SurfaceHit> intersect(const Primitive& prim, const Ray& ray);
 /// Tight bounds of a primitive.
 Bbox bounds(const Primitive& prim);
-/// Mean projected area over all directions (Cauchy: surface area / 4 for convex bodies; a
-/// triangle, seen from both sides, projects area/2 on average).
-float mean_projected_area(const Primitive& prim);
 
 enum class LightKind : std::uint8_t { kPoint, kDirectional };
 

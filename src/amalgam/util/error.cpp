@@ -7,6 +7,7 @@ namespace amalgam {
 std::string one_line(const std::string& text, std::size_t max) {
   std::string s;
   for (char c : text) s += (c == '\n' || c == '\r' || c == '\t') ? ' ' : c;
+  while (!s.empty() && s.back() == ' ') s.pop_back();
   if (s.size() > max) s = s.substr(0, max > 3 ? max - 3 : 0) + "...";
   return s;
 }

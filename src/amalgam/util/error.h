@@ -34,8 +34,10 @@ inline int exit_status(const std::exception& e) {
   return dynamic_cast<const InputError*>(&e) != nullptr ? 2 : 1;
 }
 
-/// `text` cut to one line of at most `max` characters (newlines shown as spaces, an ellipsis
-/// where it was cut): for quoting user input inside an error message.
+/// `text` on one line: newlines, carriage returns and tabs shown as spaces, trailing spaces
+/// dropped, then cut to at most `max` characters (ending in an ellipsis where it was cut). For
+/// quoting user input (default 120) or a library's message (`std::string::npos`: no cut)
+/// inside an error message.
 std::string one_line(const std::string& text, std::size_t max = 120);
 
 }  // namespace amalgam

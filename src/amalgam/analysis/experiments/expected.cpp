@@ -1,10 +1,11 @@
-/// \file The expected-case experiment on builtin:poisson (Eqs. 8-13).
+/// \file Experiment expected: the expected case on builtin:poisson, sorted traversal
+/// (Eqs. 8-13).
 
 #include <cmath>
 #include <functional>
 #include <limits>
 
-#include "amalgam/analysis/exp_common.h"
+#include "amalgam/analysis/experiments/common.h"
 #include "amalgam/analysis/formulas.h"
 #include "amalgam/builtin/tube.h"
 

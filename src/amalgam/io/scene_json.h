@@ -1,12 +1,11 @@
 #pragma once
-/// \file Scene paths: scene files (`.json`, schema in the README) and bare meshes, which get a
-/// default camera and lights.
+/// \file Scene files (`.json`, schema in the README): the reader. What it produces is a
+/// SceneDescription (scene/description.h); bare meshes are loaded by load/load_scene.h.
 
 #include <cstdint>
 #include <string>
-#include <vector>
 
-#include "amalgam/scene/scene.h"
+#include "amalgam/scene/description.h"
 #include "amalgam/util/error.h"
 
 namespace amalgam {
@@ -27,17 +26,6 @@ struct SceneFileConfig {
   std::uint64_t max_instances = 20'000'000;
 };
 
-/// A scene as described, before any hierarchy is built.
-struct SceneDescription {
-  std::vector<Primitive> prims;    ///< world space, including expanded instances
-  std::vector<Surface> materials;  ///< indexed by Primitive::material; never empty
-  Environment env;
-  /// Instanced meshes in object space (materials index `materials`), and their placements.
-  /// Empty unless the scene is large enough to keep instances (see SceneFileConfig).
-  std::vector<std::vector<Primitive>> meshes;
-  std::vector<Instance> instances;
-};
-
 /// Reads a scene file. Relative mesh paths resolve against the file's folder. Throws
 /// InputError naming the file and, for JSON syntax errors, the line and column, otherwise the
 /// JSON pointer of the offending value ("scene.json: /lights/0/intensity: expected an array
@@ -47,15 +35,5 @@ SceneDescription read_scene_json(const std::string& path, const SceneFileConfig&
 /// Parses scene-file text; `path` names it in errors and anchors relative mesh paths.
 SceneDescription parse_scene_json(const std::string& text, const std::string& path,
                                   const SceneFileConfig& config = {});
-
-/// A bare mesh (see `import_mesh`) with `frame_camera` and `default_lights`.
-SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& config = {});
-
-/// A camera that sees all of `bounds` from a 3/4 view (front-right, above; y is up).
-Camera frame_camera(const Bbox& bounds, float vfov_deg = 40.0f);
-
-/// A directional key light from above-left and a weaker point light at the camera (so that
-/// no visible surface is black).
-std::vector<Light> default_lights(const Bbox& bounds, const Camera& camera);
 
 }  // namespace amalgam

@@ -3,17 +3,17 @@
 /// per-pixel error map. Pure functions on linear-RGB pixel arrays laid out as in
 /// write_image (pixel (x, y) at index y * width + x). No I/O.
 
-#include <stdexcept>
 #include <vector>
 
 #include "amalgam/math/vec.h"
+#include "amalgam/util/error.h"
 
 namespace amalgam {
 
 /// Thrown when two images cannot be compared (different sizes, or a size that does not match
-/// the pixel count).
-struct MetricsError : std::invalid_argument {
-  using std::invalid_argument::invalid_argument;
+/// the pixel count): a precondition the caller must ensure, so an InternalError (exit status 1).
+struct MetricsError : InternalError {
+  using InternalError::InternalError;
 };
 
 /// Root-mean-square error over all pixels and all three channels of linear RGB (no

@@ -1,11 +1,12 @@
-/// \file "Linear Cost": FIND, PT2D and RAY2D on self-contained 2D hierarchies (Figures 6, 7).
-/// These are not ray tracing of the 3D scenes: the searches run on small implicit 2D
-/// hierarchies and every node (and primitive) tested is counted, as the paper describes.
+/// \file Experiment linear-cost: "Linear Cost", FIND, PT2D and RAY2D on self-contained 2D
+/// hierarchies (Figures 6, 7). These are not ray tracing of the 3D scenes: the searches run on
+/// small implicit 2D hierarchies and every node (and primitive) tested is counted, as the
+/// paper describes.
 
 #include <cmath>
 #include <cstdint>
 
-#include "amalgam/analysis/exp_common.h"
+#include "amalgam/analysis/experiments/common.h"
 #include "amalgam/math/random.h"
 
 namespace amalgam::experiments {

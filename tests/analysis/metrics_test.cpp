@@ -1,4 +1,4 @@
-#include "amalgam/io/metrics.h"
+#include "amalgam/analysis/metrics.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -1,6 +1,6 @@
 #pragma once
-/// \file Helpers shared by the experiment sources (exp_*.cpp): scene loading and tracing of
-/// the default (centre) ray.
+/// \file Helpers shared by the experiments (analysis/experiments/<name>.cpp, one file per
+/// experiment): scene loading and tracing of the default (centre) ray.
 
 #include <chrono>
 #include <string>

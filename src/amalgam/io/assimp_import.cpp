@@ -1,0 +1,166 @@
+#include "amalgam/io/assimp_import.h"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <assimp/DefaultLogger.hpp>
+#include <assimp/Importer.hpp>
+#include <cmath>
+#include <new>
+#include <string>
+#include <vector>
+
+#include "amalgam/util/error.h"
+
+namespace amalgam {
+namespace {
+
+[[noreturn]] void fail(const std::string& path, const std::string& problem) {
+  throw InputError(path + ": " + problem);
+}
+
+/// Assimp's messages can span lines; the contract wants one line, kept whole (one_line).
+constexpr std::size_t kUncut = std::string::npos;
+
+/// Collects Assimp's warnings and errors instead of printing them.
+class CaptureLogger : public Assimp::Logger {
+ public:
+  std::vector<std::string> errors, warnings;
+  bool attachStream(Assimp::LogStream*, unsigned) override { return false; }
+  bool detachStream(Assimp::LogStream*, unsigned) override { return false; }
+
+ private:
+  void OnDebug(const char*) override {}
+  void OnVerboseDebug(const char*) override {}
+  void OnInfo(const char*) override {}
+  void OnWarn(const char* m) override { warnings.push_back(one_line(m, kUncut)); }
+  void OnError(const char* m) override { errors.push_back(one_line(m, kUncut)); }
+};
+
+/// Log messages by which Assimp reports that it dropped or replaced corrupt data. Other
+/// messages (e.g. about invalid normals, which amalgam does not use) are harmless.
+constexpr const char* kCorruptionMessages[] = {
+    "out-of-range indices",         // glTF 2: faces referencing missing vertices
+    "Ignoring empty face",          // OBJ: an 'f' statement without vertices
+    "was not compatible with the",  // glTF 2: vertex count does not fit the mode
+    "Invalid face index",           // OBJ
+    "fails on mesh positions",      // FindInvalidData: NaN or infinite vertex positions
+};
+
+float clamp01(float v) {
+  return std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.8f;
+}
+
+Surface read_material(const aiMaterial& m) {
+  Surface s;
+  aiColor4D c;
+  if (m.Get(AI_MATKEY_BASE_COLOR, c) == aiReturn_SUCCESS ||
+      m.Get(AI_MATKEY_COLOR_DIFFUSE, c) == aiReturn_SUCCESS)
+    s.colour = {clamp01(c.r), clamp01(c.g), clamp01(c.b)};
+  return s;
+}
+
+}  // namespace
+
+ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& config) {
+  auto* logger = new CaptureLogger;  // owned by Assimp until set(nullptr) below
+  Assimp::DefaultLogger::set(logger);
+  struct Restore {
+    ~Restore() { Assimp::DefaultLogger::set(nullptr); }  // deletes `logger`, back to silence
+  } restore;
+
+  Assimp::Importer importer;
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  constexpr unsigned kFlags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                              aiProcess_PreTransformVertices | aiProcess_SortByPType |
+                              aiProcess_FindInvalidData | aiProcess_ValidateDataStructure;
+  const aiScene* scene = nullptr;
+  try {
+    scene = importer.ReadFile(path, kFlags);
+  } catch (const std::bad_alloc&) {
+    fail(path, "the importer ran out of memory (is the file corrupt?)");
+  } catch (const std::exception& e) {
+    fail(path, "cannot import: " + one_line(e.what(), kUncut));
+  }
+  // Assimp repairs some corrupt data with no more than a log message, and fails on other
+  // corrupt data with a message about the consequence ("No meshes remaining"): name the cause.
+  for (const auto* messages : {&logger->errors, &logger->warnings})
+    for (const std::string& m : *messages)
+      for (const char* pattern : kCorruptionMessages)
+        if (m.find(pattern) != std::string::npos) fail(path, "corrupt data: " + m);
+  if (scene == nullptr) {
+    std::string why = one_line(importer.GetErrorString(), kUncut);
+    if (why.empty() && !logger->errors.empty()) why = logger->errors.front();
+    fail(path, "cannot import: " + (why.empty() ? std::string("unknown error") : why));
+  }
+  if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
+    fail(path, "cannot import: the file holds no complete scene");
+
+  ImportedMesh out;
+  out.warnings = std::move(logger->warnings);
+  for (unsigned i = 0; i < scene->mNumMaterials; ++i)
+    out.materials.push_back(scene->mMaterials[i] ? read_material(*scene->mMaterials[i])
+                                                 : Surface{});
+  if (out.materials.empty()) out.materials.push_back(Surface{});
+
+  std::uint64_t faces = 0;
+  for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
+    const aiMesh* m = scene->mMeshes[mi];
+    if (m != nullptr && (m->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) faces += m->mNumFaces;
+  }
+  if (faces > config.max_triangles)
+    fail(path, std::to_string(faces) + " triangles, more than the limit of " +
+                   std::to_string(config.max_triangles));
+  out.triangles.reserve(faces);
+
+  for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
+    const aiMesh* m = scene->mMeshes[mi];
+    if (m == nullptr || !(m->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || m->mVertices == nullptr)
+      continue;
+    const std::string where =
+        "mesh " + std::to_string(mi) +
+        (m->mName.length ? " ('" + one_line(m->mName.C_Str(), kUncut) + "')" : "");
+    for (unsigned v = 0; v < m->mNumVertices; ++v) {
+      const aiVector3D& p = m->mVertices[v];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        fail(path, where + ": vertex " + std::to_string(v) + " is not finite (NaN or infinite)");
+    }
+    const std::uint32_t material = m->mMaterialIndex < out.materials.size() ? m->mMaterialIndex : 0;
+    for (unsigned f = 0; f < m->mNumFaces; ++f) {
+      const aiFace& face = m->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines
+      Vec3 p[3];
+      for (int k = 0; k < 3; ++k) {
+        const unsigned idx = face.mIndices[k];
+        if (idx >= m->mNumVertices)
+          fail(path, where + ": face " + std::to_string(f) + " uses vertex " + std::to_string(idx) +
+                         " of " + std::to_string(m->mNumVertices));
+        const aiVector3D& q = m->mVertices[idx];
+        p[k] = {q.x, q.y, q.z};
+      }
+      // Zero area (in double, so tiny but proper triangles survive).
+      const double ux = double(p[1].x) - p[0].x, uy = double(p[1].y) - p[0].y,
+                   uz = double(p[1].z) - p[0].z;
+      const double vx = double(p[2].x) - p[0].x, vy = double(p[2].y) - p[0].y,
+                   vz = double(p[2].z) - p[0].z;
+      const double cx = uy * vz - uz * vy, cy = uz * vx - ux * vz, cz = ux * vy - uy * vx;
+      if (!(cx * cx + cy * cy + cz * cz > 0.0)) {
+        ++out.dropped_degenerate;
+        continue;
+      }
+      out.triangles.push_back(Primitive::triangle(p[0], p[1], p[2], material));
+      out.bounds.extend(p[0]);
+      out.bounds.extend(p[1]);
+      out.bounds.extend(p[2]);
+    }
+  }
+  if (out.triangles.empty())
+    fail(path, out.dropped_degenerate
+                   ? "all " + std::to_string(out.dropped_degenerate) + " triangles have zero area"
+                   : std::string("contains no triangles"));
+  return out;
+}
+
+}  // namespace amalgam

@@ -1,0 +1,439 @@
+#include "amalgam/io/scene_json.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "amalgam/io/json_reader.h"
+#include "amalgam/io/mesh_import.h"
+#include "amalgam/io/scene_json_parts.h"
+#include "amalgam/math/transform.h"
+#include "amalgam/scene/coordinate_limit.h"
+#include "amalgam/scene/framing.h"
+#include "amalgam/scene/instance_patterns.h"
+#include "amalgam/scene/subdivide.h"
+
+namespace amalgam {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+using Affine = AffineD;  // composed in double, rounded once per instance
+
+std::string fmt(double v) {
+  return JsonReader::format(v);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The scene file proper: its structure (materials by name, meshes, instances, the limits on
+// what it may expand to). The parts that stand alone are read by scene_json_parts.h.
+
+struct MeshEntry {
+  std::string name;
+  std::shared_ptr<const ImportedMesh> mesh;
+  Affine model;                           ///< fit, then the mesh's transform
+  std::optional<std::uint32_t> material;  ///< override
+  std::string ptr;
+};
+
+class SceneParser {
+ public:
+  SceneParser(const std::string& path, const SceneFileConfig& config)
+      : r_(path), dir_(fs::path(path).parent_path()), config_(config) {}
+
+  SceneDescription parse(const json& doc) {
+    const JsonValue root{doc, ""};
+    r_.object(root, {"camera", "lights", "background", "materials", "meshes", "spheres", "boxes",
+                     "triangles", "instances"});
+    out_.materials.push_back(Surface{});  // 0: the default material
+    if (auto m = r_.find(root, "materials")) read_materials(*m);
+    if (auto b = r_.find(root, "background")) out_.env.background = r_.colour(*b);
+
+    // First count, then expand: an oversized scene fails before anything is allocated.
+    std::vector<JsonValue> spheres, boxes, triangles;
+    if (auto v = r_.find(root, "spheres")) spheres = r_.items(*v);
+    if (auto v = r_.find(root, "boxes")) boxes = r_.items(*v);
+    if (auto v = r_.find(root, "triangles")) triangles = r_.items(*v);
+    if (auto v = r_.find(root, "meshes")) read_meshes(*v);
+    std::vector<Placement> placements;
+    if (auto v = r_.find(root, "instances")) placements = read_instances(*v);
+    // Expand everything when the expanded scene is small; else keep large meshes instanced.
+    double everything = static_cast<double>(spheres.size() + boxes.size() + triangles.size());
+    for (const MeshEntry& m : meshes_)
+      if (placed_.count(m.name)) everything += static_cast<double>(m.mesh->triangles.size());
+    for (const Placement& p : placements)
+      everything +=
+          static_cast<double>(p.mesh->mesh->triangles.size()) * static_cast<double>(p.where.size());
+    const bool expand_all =
+        everything <= static_cast<double>(std::min(config_.expand_limit, config_.max_triangles));
+    std::uint64_t total = spheres.size() + boxes.size() + triangles.size();
+    std::uint64_t kept = 0;
+    for (const MeshEntry& m : meshes_)
+      if (placed_.count(m.name)) add_count(total, m.mesh->triangles.size(), m.ptr);
+    for (Placement& p : placements) {
+      p.expand = expand_all || p.mesh->mesh->triangles.size() < config_.instance_min_triangles;
+      if (p.expand) {
+        add_count(total, static_cast<double>(p.mesh->mesh->triangles.size()) * p.where.size(),
+                  p.ptr);
+      } else {
+        kept += p.where.size();
+        if (kept > config_.max_instances)
+          r_.fail(p.ptr, "the scene would hold " + fmt(static_cast<double>(kept)) +
+                             " instances, more than the limit of " +
+                             fmt(static_cast<double>(config_.max_instances)));
+      }
+    }
+    out_.prims.reserve(total);
+    out_.instances.reserve(kept);
+
+    for (const JsonValue& s : spheres) read_sphere(s);
+    for (const JsonValue& b : boxes) read_box(b);
+    for (const JsonValue& t : triangles) read_triangle(t);
+    for (const MeshEntry& m : meshes_)
+      if (placed_.count(m.name)) place(m, Affine{}, m.material);
+    Bbox bounds;
+    for (const Placement& p : placements) {
+      const auto material = p.material ? p.material : p.mesh->material;
+      if (p.expand) {
+        for (const Affine& a : p.where) place(*p.mesh, a, material);
+      } else {
+        const std::uint32_t mesh = instanced_mesh(*p.mesh, material);
+        const Bbox object = object_bounds_[mesh];
+        for (const Affine& a : p.where) {
+          Instance in;
+          for (int i = 0; i < 3; ++i)
+            for (int k = 0; k < 4; ++k) in.to_world.m[i][k] = static_cast<float>(a.m[i][k]);
+          in.mesh = mesh;
+          out_.instances.push_back(in);
+          for (int c = 0; c < 8; ++c)
+            bounds.extend(
+                a.point({c & 1 ? object.hi.x : object.lo.x, c & 2 ? object.hi.y : object.lo.y,
+                         c & 4 ? object.hi.z : object.lo.z}));
+        }
+      }
+    }
+    if (out_.prims.empty() && out_.instances.empty())
+      r_.fail("",
+              "the scene has no geometry (give meshes, spheres, boxes, triangles or "
+              "instances)");
+
+    for (const Primitive& p : out_.prims) bounds.extend(amalgam::bounds(p));
+    check_extent(bounds, r_.file());  // transforms can scale valid input beyond the range
+    if (auto c = r_.find(root, "camera"))
+      out_.env.camera = scene_json::read_camera(r_, *c);
+    else
+      out_.env.camera = frame_camera(bounds);
+    if (auto l = r_.find(root, "lights"))
+      read_lights(*l);
+    else
+      out_.env.lights = default_lights(bounds, out_.env.camera);
+    return std::move(out_);
+  }
+
+ private:
+  struct Placement {
+    const MeshEntry* mesh;
+    std::vector<Affine> where;
+    std::optional<std::uint32_t> material;
+    std::string ptr;
+    bool expand = true;  ///< into triangles, or kept as instances
+  };
+
+  /// The object-space mesh of `m` with `material` (or its own materials), made once.
+  std::uint32_t instanced_mesh(const MeshEntry& m, std::optional<std::uint32_t> material) {
+    const auto key = std::make_pair(&m, material ? static_cast<std::int64_t>(*material) : -1);
+    auto it = instanced_.find(key);
+    if (it != instanced_.end()) return it->second;
+    const auto index = static_cast<std::uint32_t>(out_.meshes.size());
+    const std::size_t before = out_.prims.size();
+    place(m, Affine{}, material);  // appends world = object-space triangles to out_.prims
+    std::vector<Primitive> tris(out_.prims.begin() + static_cast<std::ptrdiff_t>(before),
+                                out_.prims.end());
+    out_.prims.resize(before);
+    Bbox b;
+    for (const Primitive& t : tris) b.extend(amalgam::bounds(t));
+    object_bounds_.push_back(b);
+    out_.meshes.push_back(std::move(tris));
+    instanced_.emplace(key, index);
+    return index;
+  }
+
+  void add_count(std::uint64_t& total, double more, const std::string& ptr) const {
+    if (static_cast<double>(total) + more > static_cast<double>(config_.max_triangles))
+      r_.fail(ptr, "the scene would hold " + fmt(static_cast<double>(total) + more) +
+                       " primitives, more than the limit of " +
+                       fmt(static_cast<double>(config_.max_triangles)) +
+                       " (instances of meshes with fewer than " +
+                       fmt(static_cast<double>(config_.instance_min_triangles)) +
+                       " triangles are expanded into triangles)");
+    total += static_cast<std::uint64_t>(more);
+  }
+
+  // -- materials ------------------------------------------------------------------------------
+
+  void read_materials(const JsonValue& v) {
+    if (!v.j.is_object()) r_.fail(v.ptr, "expected an object mapping names to materials");
+    for (const auto& [name, value] : v.j.items()) {
+      material_index_[name] = static_cast<std::uint32_t>(out_.materials.size());
+      out_.materials.push_back(scene_json::read_surface(r_, JsonReader::child(v, name)));
+    }
+  }
+
+  /// A "material" value: the name of a material, or a material object.
+  std::uint32_t material_ref(const JsonValue& v) {
+    if (v.j.is_string()) {
+      const std::string name = v.j.get<std::string>();
+      auto it = material_index_.find(name);
+      if (it == material_index_.end()) {
+        std::string list;
+        for (const auto& [n, i] : material_index_) list += (list.empty() ? "" : ", ") + n;
+        r_.fail(v.ptr, "unknown material '" + name + "' (" +
+                           (list.empty() ? "no materials are defined" : "defined: " + list) + ")");
+      }
+      return it->second;
+    }
+    if (!v.j.is_object())
+      r_.fail(v.ptr,
+              "expected a material name or a material object, found " + JsonReader::type(v.j));
+    out_.materials.push_back(scene_json::read_surface(r_, v));
+    return static_cast<std::uint32_t>(out_.materials.size() - 1);
+  }
+  std::uint32_t optional_material(const JsonValue& v) {
+    if (auto m = r_.find(v, "material")) return material_ref(*m);
+    return 0;
+  }
+
+  // -- camera and lights ----------------------------------------------------------------------
+
+  void read_lights(const JsonValue& v) {
+    for (const JsonValue& l : r_.items(v)) out_.env.lights.push_back(scene_json::read_light(r_, l));
+  }
+
+  // -- primitives -----------------------------------------------------------------------------
+
+  void read_sphere(const JsonValue& v) {
+    Primitive p = scene_json::read_sphere(r_, v);
+    p.material = optional_material(v);
+    out_.prims.push_back(p);
+  }
+
+  void read_box(const JsonValue& v) {
+    Primitive p = scene_json::read_box(r_, v);
+    p.material = optional_material(v);
+    out_.prims.push_back(p);
+  }
+
+  void read_triangle(const JsonValue& v) {
+    Primitive p = scene_json::read_triangle(r_, v);
+    p.material = optional_material(v);
+    out_.prims.push_back(p);
+  }
+
+  // -- meshes and instances -------------------------------------------------------------------
+
+  void read_meshes(const JsonValue& v) {
+    for (const JsonValue& m : r_.items(v)) {
+      r_.object(m, {"file", "name", "transform", "material", "fit", "place", "subdivide"});
+      const JsonValue file = r_.require(m, "file");
+      const fs::path rel = r_.string(file);
+      const fs::path full = rel.is_absolute() || dir_.empty() ? rel : dir_ / rel;
+      MeshEntry e;
+      e.ptr = m.ptr;
+      e.name = m.j.contains("name") ? r_.string(JsonReader::child(m, "name")) : m.ptr;
+      for (const MeshEntry& other : meshes_)
+        if (other.name == e.name)
+          r_.fail(m.ptr + "/name", "a mesh named '" + e.name + "' already exists");
+      auto cached = imported_.find(full.string());
+      if (cached == imported_.end()) {
+        try {
+          ImportConfig ic;
+          ic.max_triangles = config_.max_triangles;
+          cached =
+              imported_
+                  .emplace(full.string(),
+                           std::make_shared<const ImportedMesh>(import_mesh(full.string(), ic)))
+                  .first;
+        } catch (const InputError& err) {
+          r_.fail(file.ptr, err.what());
+        }
+      }
+      e.mesh = cached->second;
+      if (auto sub = r_.find(m, "subdivide")) {
+        const auto levels = static_cast<int>(r_.integer(*sub, 0, 8));
+        const double tris = static_cast<double>(e.mesh->triangles.size()) * std::pow(4.0, levels);
+        if (tris > static_cast<double>(config_.max_triangles))
+          r_.fail(sub->ptr, "subdividing " + fmt(static_cast<double>(e.mesh->triangles.size())) +
+                                " triangles " + std::to_string(levels) + " times gives " +
+                                fmt(tris) + ", more than the limit of " +
+                                fmt(static_cast<double>(config_.max_triangles)));
+        if (levels > 0) {
+          ImportedMesh fine = *e.mesh;
+          fine.triangles = subdivide(e.mesh->triangles, levels);
+          e.mesh = std::make_shared<const ImportedMesh>(std::move(fine));
+        }
+      }
+      if (auto f = r_.find(m, "fit")) {
+        // Uniform scale to the given largest extent, centred in x and z, resting on y = 0.
+        const Bbox b = e.mesh->bounds;
+        const double s = r_.positive(*f) / std::max(max_component(b.extent()), 1e-30f);
+        e.model =
+            Affine::scale({static_cast<float>(s), static_cast<float>(s), static_cast<float>(s)}) *
+            Affine::translate({-b.center().x, -b.lo.y, -b.center().z});
+      }
+      if (auto t = r_.find(m, "transform")) e.model = scene_json::read_transform(r_, *t) * e.model;
+      if (auto mat = r_.find(m, "material")) e.material = material_ref(*mat);
+      const bool show = m.j.contains("place") ? r_.boolean(JsonReader::child(m, "place")) : true;
+      meshes_.push_back(std::move(e));
+      if (show) placed_.insert(meshes_.back().name);
+    }
+    for (const MeshEntry& e : meshes_) by_name_[e.name] = &e;
+  }
+
+  std::vector<Placement> read_instances(const JsonValue& v) {
+    std::vector<Placement> out;
+    for (const JsonValue& in : r_.items(v)) {
+      r_.object(in, {"mesh", "transform", "material", "transforms", "grid", "scatter"});
+      const JsonValue name = r_.require(in, "mesh");
+      const std::string n = r_.string(name);
+      auto it = by_name_.find(n);
+      if (it == by_name_.end()) {
+        std::string list;
+        for (const auto& [k, e] : by_name_) list += (list.empty() ? "" : ", ") + k;
+        r_.fail(name.ptr,
+                "no mesh named '" + n + "' (" +
+                    (list.empty() ? std::string("no meshes are defined") : "meshes: " + list) +
+                    ")");
+      }
+      Placement p{it->second, {}, std::nullopt, in.ptr};
+      const Affine local = in.j.contains("transform")
+                               ? scene_json::read_transform(r_, JsonReader::child(in, "transform"))
+                               : Affine{};
+      if (auto mat = r_.find(in, "material")) p.material = material_ref(*mat);
+      const int kinds =
+          in.j.contains("transforms") + in.j.contains("grid") + in.j.contains("scatter");
+      if (kinds != 1) r_.fail(in.ptr, "expected exactly one of 'transforms', 'grid' or 'scatter'");
+      std::vector<Affine> where;
+      if (auto t = r_.find(in, "transforms")) {
+        for (const JsonValue& e : r_.items(*t)) where.push_back(scene_json::read_transform(r_, e));
+      } else if (auto g = r_.find(in, "grid")) {
+        where = read_grid(*g, it->second->mesh->triangles.size());
+      } else {
+        where = read_scatter(r_.require(in, "scatter"), it->second->mesh->triangles.size());
+      }
+      for (Affine& a : where) a = a * local;
+      p.where = std::move(where);
+      out.push_back(std::move(p));
+    }
+    return out;
+  }
+
+  static constexpr std::int64_t kMaxInstances = 100'000'000;
+
+  std::vector<Affine> read_grid(const JsonValue& v, std::size_t triangles) const {
+    r_.object(v, {"nx", "nz", "spacing", "origin"});
+    const std::int64_t nx = r_.integer(r_.require(v, "nx"), 1, 1'000'000);
+    const std::int64_t nz = r_.integer(r_.require(v, "nz"), 1, 1'000'000);
+    const double spacing = r_.positive(r_.require(v, "spacing"));
+    const Vec3 origin = v.j.contains("origin") ? r_.vec3(JsonReader::child(v, "origin")) : Vec3{};
+    if (nx * nz > kMaxInstances)
+      r_.fail(v.ptr, "nx * nz = " + std::to_string(nx * nz) + " instances, more than " +
+                         std::to_string(kMaxInstances));
+    add_instances_check(static_cast<double>(nx * nz), triangles, v.ptr);
+    return grid_placements({nx, nz, spacing, origin});
+  }
+
+  std::vector<Affine> read_scatter(const JsonValue& v, std::size_t triangles) const {
+    r_.object(v, {"count", "radius", "seed", "centre", "center", "rotate"});
+    const std::int64_t count = r_.integer(r_.require(v, "count"), 1, kMaxInstances);
+    const double radius = r_.positive(r_.require(v, "radius"));
+    const auto seed = static_cast<std::uint64_t>(
+        v.j.contains("seed") ? r_.integer(JsonReader::child(v, "seed"), 0, INT64_MAX) : 0);
+    const Vec3 centre = [&] {
+      auto c = r_.find(v, "centre", "center");
+      return c ? r_.vec3(*c) : Vec3{};
+    }();
+    const bool rotate = v.j.contains("rotate") ? r_.boolean(JsonReader::child(v, "rotate")) : true;
+    add_instances_check(static_cast<double>(count), triangles, v.ptr);
+    return scatter_placements({count, radius, seed, centre, rotate});
+  }
+
+  /// Fails before the generator allocates its transforms when its instances alone would hold
+  /// too many triangles (the scene-wide count is checked again once all are read).
+  void add_instances_check(double count, std::size_t triangles, const std::string& ptr) const {
+    const double total = count * static_cast<double>(triangles);
+    if (count > static_cast<double>(config_.max_instances))
+      r_.fail(ptr, fmt(count) + " instances, more than the limit of " +
+                       fmt(static_cast<double>(config_.max_instances)));
+    // Only meshes too small to instance are sure to be expanded at this point.
+    if (triangles < config_.instance_min_triangles &&
+        total > static_cast<double>(config_.max_triangles))
+      r_.fail(ptr, fmt(count) + " instances of " + fmt(static_cast<double>(triangles)) +
+                       " triangles would hold " + fmt(total) +
+                       " triangles, more than the limit of " +
+                       fmt(static_cast<double>(config_.max_triangles)) +
+                       " (instances of meshes with fewer than " +
+                       fmt(static_cast<double>(config_.instance_min_triangles)) +
+                       " triangles are expanded into triangles)");
+  }
+
+  void place(const MeshEntry& m, const Affine& where, std::optional<std::uint32_t> material) {
+    const Affine a = where * m.model;
+    const auto base = static_cast<std::uint32_t>(out_.materials.size());
+    const bool own = !material.has_value();
+    if (own) {
+      // The mesh's own materials, appended once per mesh entry.
+      auto it = material_base_.find(&m);
+      if (it == material_base_.end()) {
+        out_.materials.insert(out_.materials.end(), m.mesh->materials.begin(),
+                              m.mesh->materials.end());
+        it = material_base_.emplace(&m, base).first;
+      }
+      for (const Primitive& t : m.mesh->triangles)
+        out_.prims.push_back(
+            Primitive::triangle(a.point(t.a), a.point(t.b), a.point(t.c), it->second + t.material));
+    } else {
+      for (const Primitive& t : m.mesh->triangles)
+        out_.prims.push_back(
+            Primitive::triangle(a.point(t.a), a.point(t.b), a.point(t.c), *material));
+    }
+  }
+
+  JsonReader r_;
+  fs::path dir_;
+  SceneFileConfig config_;
+  SceneDescription out_;
+  std::map<std::string, std::uint32_t> material_index_;
+  std::map<std::string, std::shared_ptr<const ImportedMesh>> imported_;
+  std::vector<MeshEntry> meshes_;
+  std::set<std::string> placed_;
+  std::map<std::string, const MeshEntry*> by_name_;
+  std::map<const MeshEntry*, std::uint32_t> material_base_;
+  std::map<std::pair<const MeshEntry*, std::int64_t>, std::uint32_t> instanced_;
+  std::vector<Bbox> object_bounds_;  ///< per instanced mesh
+};
+
+}  // namespace
+
+SceneDescription parse_scene_json(const std::string& text, const std::string& path,
+                                  const SceneFileConfig& config) {
+  const json doc = parse_json(text, path);
+  return SceneParser(path, config).parse(doc);
+}
+
+SceneDescription read_scene_json(const std::string& path, const SceneFileConfig& config) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw InputError(path + ": no such file");
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  if (!in || !(text << in.rdbuf())) throw InputError(path + ": cannot read the file");
+  return parse_scene_json(text.str(), path, config);
+}
+
+}  // namespace amalgam

@@ -1,0 +1,134 @@
+#include "amalgam/io/scene_json_parts.h"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace amalgam::scene_json {
+
+Surface read_surface(const JsonReader& r, const JsonValue& v) {
+  r.object(v, {"colour", "color", "reflectance", "shininess"});
+  Surface s;
+  if (auto c = r.find(v, "colour", "color")) s.colour = r.colour(*c);
+  if (auto c = r.find(v, "reflectance")) s.reflectance = static_cast<float>(r.number(*c, 0, 1));
+  if (auto c = r.find(v, "shininess")) s.shininess = static_cast<float>(r.number(*c, 1e-3, 1e6));
+  return s;
+}
+
+Camera read_camera(const JsonReader& r, const JsonValue& v) {
+  r.object(v, {"position", "look_at", "up", "vfov"});
+  Camera c;
+  c.position = r.vec3(r.require(v, "position"));
+  c.look_at = r.vec3(r.require(v, "look_at"));
+  if (auto u = r.find(v, "up")) c.up = r.direction(*u);
+  if (auto f = r.find(v, "vfov"))
+    c.vfov_deg = static_cast<float>(r.number(*f, 0.01, 179.0, "in (0, 180) degrees"));
+  const Vec3 d = c.look_at - c.position;
+  if (!(length(d) > 0.0f)) r.fail(v.ptr + "/look_at", "must differ from the position");
+  if (!(length(cross(normalize(d), normalize(c.up))) > 1e-6f))
+    r.fail(v.ptr + "/up", "must not be parallel to the viewing direction");
+  return c;
+}
+
+Light read_light(const JsonReader& r, const JsonValue& l) {
+  const std::string type = r.string(r.require(l, "type"));
+  Light light;
+  if (type == "point") {
+    r.object(l, {"type", "position", "intensity"});
+    light.kind = LightKind::kPoint;
+    light.position = r.vec3(r.require(l, "position"));
+  } else if (type == "directional") {
+    r.object(l, {"type", "direction", "intensity"});
+    light.kind = LightKind::kDirectional;
+    light.direction = normalize(r.direction(r.require(l, "direction")));
+  } else {
+    r.fail(l.ptr + "/type", "expected \"point\" or \"directional\", found \"" + type + "\"");
+  }
+  light.intensity = r.colour(r.require(l, "intensity"));
+  return light;
+}
+
+Primitive read_sphere(const JsonReader& r, const JsonValue& v) {
+  r.object(v, {"centre", "center", "radius", "material"});
+  const Vec3 c = r.vec3(r.require(v, "centre", "center"));
+  const auto radius = static_cast<float>(r.positive(r.require(v, "radius")));
+  return Primitive::sphere(c, radius);
+}
+
+Primitive read_box(const JsonReader& r, const JsonValue& v) {
+  r.object(v, {"min", "max", "material"});
+  const Vec3 lo = r.vec3(r.require(v, "min")), hi = r.vec3(r.require(v, "max"));
+  if (lo.x > hi.x || lo.y > hi.y || lo.z > hi.z)
+    r.fail(v.ptr + "/max", "expected max >= min in every coordinate");
+  return Primitive::box(lo, hi);
+}
+
+Primitive read_triangle(const JsonReader& r, const JsonValue& v) {
+  r.object(v, {"vertices", "material"});
+  const JsonValue vs = r.require(v, "vertices");
+  if (!vs.j.is_array() || vs.j.size() != 3)
+    r.fail(vs.ptr, "expected an array of 3 vertices (each an array of 3 numbers)");
+  Vec3 p[3];
+  for (std::size_t i = 0; i < 3; ++i) p[i] = r.vec3(JsonReader::element(vs, i));
+  // Zero area, in double as the mesh importer does: in float, the cross product of a proper
+  // triangle with 1e-18 legs underflows (tests/geometry/robust_test.cpp).
+  double u[3], w[3];
+  for (int k = 0; k < 3; ++k) u[k] = double(p[1][k]) - p[0][k], w[k] = double(p[2][k]) - p[0][k];
+  const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2],
+               cz = u[0] * w[1] - u[1] * w[0];
+  if (!(cx * cx + cy * cy + cz * cz > 0.0)) r.fail(vs.ptr, "the triangle has zero area");
+  return Primitive::triangle(p[0], p[1], p[2]);
+}
+
+AffineD read_transform(const JsonReader& r, const JsonValue& v) {
+  r.object(v, {"matrix", "translate", "scale", "rotate_x_deg", "rotate_y_deg", "rotate_z_deg"});
+  AffineD a;
+  if (auto m = r.find(v, "matrix")) {
+    if (v.j.size() != (v.j.contains("comment") ? 2u : 1u))
+      r.fail(v.ptr, "'matrix' cannot be combined with translate, scale or rotate");
+    a = read_matrix(r, *m);
+  } else {
+    if (auto s = r.find(v, "scale")) {
+      Vec3 k;
+      if (s->j.is_number()) {
+        const auto f = static_cast<float>(r.number(*s));
+        k = {f, f, f};
+      } else {
+        k = r.vec3(*s);
+      }
+      if (k.x == 0 || k.y == 0 || k.z == 0) r.fail(s->ptr, "scale factors must not be zero");
+      a = AffineD::scale(k);
+    }
+    const char* rot[] = {"rotate_x_deg", "rotate_y_deg", "rotate_z_deg"};
+    for (int axis = 0; axis < 3; ++axis)
+      if (auto rd = r.find(v, rot[axis])) a = AffineD::rotate(axis, r.number(*rd)) * a;
+    if (auto t = r.find(v, "translate")) a = AffineD::translate(r.vec3(*t)) * a;
+  }
+  return a;
+}
+
+AffineD read_matrix(const JsonReader& r, const JsonValue& v) {
+  const char* expected = "expected a 4x4 matrix: 4 rows of 4 numbers, or 16 numbers, row-major";
+  std::vector<double> m;
+  if (!v.j.is_array()) r.fail(v.ptr, expected);
+  if (v.j.size() == 16) {
+    for (std::size_t i = 0; i < 16; ++i) m.push_back(r.number(JsonReader::element(v, i)));
+  } else if (v.j.size() == 4) {
+    for (std::size_t i = 0; i < 4; ++i) {
+      const JsonValue row = JsonReader::element(v, i);
+      if (!row.j.is_array() || row.j.size() != 4) r.fail(row.ptr, "expected a row of 4 numbers");
+      for (std::size_t k = 0; k < 4; ++k) m.push_back(r.number(JsonReader::element(row, k)));
+    }
+  } else {
+    r.fail(v.ptr, expected);
+  }
+  if (m[12] != 0 || m[13] != 0 || m[14] != 0 || m[15] != 1)
+    r.fail(v.ptr, "expected an affine matrix (last row 0 0 0 1)");
+  AffineD a;
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 4; ++k) a.m[i][k] = m[static_cast<std::size_t>(i * 4 + k)];
+  if (!(std::fabs(a.det()) > 0)) r.fail(v.ptr, "the matrix is singular");
+  return a;
+}
+
+}  // namespace amalgam::scene_json

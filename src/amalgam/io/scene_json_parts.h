@@ -1,0 +1,37 @@
+#pragma once
+/// \file The parts of a scene file that stand alone (io/scene_json.h reads the rest): a
+/// material, the camera, a light, a sphere, box or triangle, a transform. Each checks its
+/// value and throws InputError naming the JSON pointer of what is wrong (JsonReader).
+
+#include "amalgam/io/json_reader.h"
+#include "amalgam/math/transform.h"
+#include "amalgam/scene/scene.h"
+
+namespace amalgam::scene_json {
+
+/// {"colour" (or "color"), "reflectance", "shininess"}, each optional.
+Surface read_surface(const JsonReader& r, const JsonValue& v);
+
+/// {"position", "look_at", "up", "vfov"}: up must not be parallel to the view direction.
+Camera read_camera(const JsonReader& r, const JsonValue& v);
+
+/// {"type": "point", "position", "intensity"} or {"type": "directional", "direction",
+/// "intensity"} (the direction normalised).
+Light read_light(const JsonReader& r, const JsonValue& v);
+
+/// The geometry of {"centre" (or "center"), "radius", "material"}, {"min", "max", "material"}
+/// or {"vertices", "material"} (a triangle of non-zero area); the material is left 0 for the
+/// caller, which resolves it after these checks.
+Primitive read_sphere(const JsonReader& r, const JsonValue& v);
+Primitive read_box(const JsonReader& r, const JsonValue& v);
+Primitive read_triangle(const JsonReader& r, const JsonValue& v);
+
+/// {"matrix"} alone, or "scale" (a number or 3), then "rotate_x_deg", "rotate_y_deg",
+/// "rotate_z_deg", then "translate", applied in that order.
+AffineD read_transform(const JsonReader& r, const JsonValue& v);
+
+/// A non-singular affine 4x4 matrix: 4 rows of 4 numbers or 16 numbers, row-major, last row
+/// 0 0 0 1.
+AffineD read_matrix(const JsonReader& r, const JsonValue& v);
+
+}  // namespace amalgam::scene_json

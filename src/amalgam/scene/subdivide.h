@@ -1,0 +1,15 @@
+#pragma once
+/// \file Flat subdivision of triangle meshes (a scene file's "subdivide").
+
+#include <vector>
+
+#include "amalgam/scene/scene.h"
+
+namespace amalgam {
+
+/// Splits every triangle into 4 at its edge midpoints, `levels` times: the same surface with
+/// 4^levels times the triangles, each keeping its material. `triangles` must all be
+/// kTriangle; levels <= 0 returns them unchanged.
+std::vector<Primitive> subdivide(const std::vector<Primitive>& triangles, int levels);
+
+}  // namespace amalgam
