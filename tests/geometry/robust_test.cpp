@@ -416,7 +416,12 @@ TEST(Degenerate, NanAndInfiniteVerticesDoNotCrashTheRenderer) {
 }
 
 TEST(Degenerate, HugeAndTinyCoordinatesRender) {
-  for (const float scale : {1e-20f, 1e-10f, 1e10f, 1e20f}) {
+  // Within the range the float kernels resolve (extents relative to the camera of 1e-10 ..
+  // 1e12: the watertight test's t is a sum of products of three coordinates), a correct
+  // render: finite, and the cube, sphere and box show. Beyond it (1e-20, 1e20, tiny next to
+  // huge), the contract is a finite image, never a crash or a hang; scene files and meshes
+  // reject such coordinates with a message (Degenerate.SceneJsonRejectsOrRendersExtremeInput).
+  for (const float scale : {1e-20f, 1e-10f, 1e10f, 1e12f, 1e20f}) {
     std::vector<Primitive> prims;
     for (const auto& t : cube().transformed(scale, {}).primitives()) prims.push_back(t);
     prims.push_back(Primitive::sphere({2 * scale, 0, 0}, 0.5f * scale));
@@ -424,8 +429,10 @@ TEST(Degenerate, HugeAndTinyCoordinatesRender) {
     Camera c;
     c.position = Vec3{1.5f, 2.0f, 6.0f} * scale;
     c.look_at = {0, 0, 0};
-    const std::vector<RenderOutput> out = render_prims(prims, c);
-    expect_finite_image(out, "scale " + std::to_string(scale));
+    const bool resolved = scale >= 1e-10f && scale <= 1e12f;
+    char name[32];
+    std::snprintf(name, sizeof name, "scale %g", static_cast<double>(scale));
+    expect_finite_image(render_prims(prims, c), name, resolved ? 6 : 0);
   }
   // Mixed: a tiny triangle next to a huge one.
   std::vector<Primitive> mixed = {
@@ -434,7 +441,7 @@ TEST(Degenerate, HugeAndTinyCoordinatesRender) {
   };
   Camera c;
   c.position = {0, 0, 5};
-  expect_finite_image(render_prims(mixed, c), "tiny next to huge");
+  expect_finite_image(render_prims(mixed, c), "tiny next to huge", 0);
 }
 
 std::string scene_with(const std::string& geometry) {
@@ -479,21 +486,23 @@ TEST(Degenerate, SceneJsonRejectsOrRendersExtremeInput) {
       {R"("boxes": [{"min": [1, 0, 0], "max": [0, 1, 1]}])", "/boxes/0/max"},
       {R"("triangles": [{"vertices": [[-1e20, -1e20, 0], [1e20, -1e20, 0], [0, 1e20, 0]]}])",
        "/triangles/0/vertices/0"},
-      {R"("triangles": [{"vertices": [[-1e18, -1e18, 0], [1e18, -1e18, 0], [0, 1e18, 0]]}])",
+      {R"("triangles": [{"vertices": [[-1e12, -1e12, 0], [1e12, -1e12, 0], [0, 1e12, 0]]}])",
        nullptr},
-      {R"("spheres": [{"centre": [0, 0, 0], "radius": 1e18}])", nullptr},
-      {R"("spheres": [{"centre": [0, 0, 0], "radius": 1e19}])", "expected a number <= 1e18"},
+      {R"("triangles": [{"vertices": [[-1e13, -1e13, 0], [1e13, -1e13, 0], [0, 1e13, 0]]}])",
+       "/triangles/0/vertices/0"},
+      {R"("spheres": [{"centre": [0, 0, 0], "radius": 1e12}])", nullptr},
+      {R"("spheres": [{"centre": [0, 0, 0], "radius": 1e13}])", "expected a number <= 1e12"},
       {R"("meshes": [{"file": "/usr/share/assimp/models/OBJ/box.obj",
-                      "transform": {"scale": 1e17, "translate": [1e18, 0, 0]}}])",
+                      "transform": {"scale": 1e11, "translate": [1e12, 0, 0]}}])",
        "beyond the supported range"},
       {R"("triangles": [{"vertices": [[0, 0, 0], [1e-20, 0, 0], [0, 1e-20, 0]]}])", nullptr},
       {R"("triangles": [{"vertices": [[0, 0, 0], [1e-18, 0, 0], [0, 1e-18, 0]]}])", nullptr},
       {R"("triangles": [{"vertices": [[0, 0, 0], [1e-30, 0, 0], [0, 1e-30, 0]]}])", nullptr},
       {R"("triangles": [{"vertices": [[1, 1, 1], [1, 1, 1], [1, 1, 1.0000001]]}])", "zero area"},
       {R"("spheres": [{"centre": [0, 0, 0], "radius": 1e-20}])", nullptr},
-      {R"("spheres": [{"centre": [1e18, 1e18, 1e18], "radius": 1e-20}])", nullptr},
+      {R"("spheres": [{"centre": [1e12, 1e12, 1e12], "radius": 1e-20}])", nullptr},
       {R"("spheres": [{"centre": [1e20, 0, 0], "radius": 1}])", "/spheres/0/centre"},
-      {R"("boxes": [{"min": [-1e18, -1e18, -1e18], "max": [1e18, 1e18, -1]}])", nullptr},
+      {R"("boxes": [{"min": [-1e12, -1e12, -1e12], "max": [1e12, 1e12, -1]}])", nullptr},
       {R"("boxes": [{"min": [0, 0, 0], "max": [1e-20, 1e-20, 1e-20]}])", nullptr},
   };
   for (const Case& c : cases) {

@@ -9,6 +9,7 @@
 /// `intersect_triangle` is the three in sequence: the results are bit-identical either way.
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <utility>
 
@@ -79,7 +80,32 @@ struct TriangleCandidate {
   float t, u, v, w, det;
 };
 
-/// The watertight test proper over [ray.tmin, ray.tmax]; fills `out` on a hit.
+/// A conservative bound on the rounding error of the t that `triangle_test` computes: from
+/// the sheared vertices (x, y), their coordinates along the ray's dominant axis before (z)
+/// and after (sz * z) scaling, the edge functions u, v, w and their sum det. The error terms
+/// are those of Pharr, Jakob, Humphreys, pbrt 3, section 3.9.6 (the shear, the edge functions,
+/// their weighted sum), except that the shear's term uses the unscaled z: the shear adds
+/// sx * z with |sx| <= 1, so its size is |z|, not |sz * z| (which grows without bound as the
+/// direction shrinks: a ray of direction length 1e-15 would reject every hit). A hit at t at or
+/// below the bound may lie behind the ray's origin: a shadow ray leaving a triangle whose
+/// point error is zero along its normal (a plane at coordinate 0) would otherwise meet it again.
+inline float triangle_t_error(float ax, float ay, float bx, float by, float cx, float cy,
+                              float az, float bz, float cz, float sz, float u, float v,
+                              float w, float det) {
+  const float max_x = std::max(std::max(std::fabs(ax), std::fabs(bx)), std::fabs(cx));
+  const float max_y = std::max(std::max(std::fabs(ay), std::fabs(by)), std::fabs(cy));
+  const float max_z = std::max(std::max(std::fabs(az), std::fabs(bz)), std::fabs(cz));
+  const float max_zs = max_z * std::fabs(sz);
+  const float max_e = std::max(std::max(std::fabs(u), std::fabs(v)), std::fabs(w));
+  const float dz = gamma(3) * max_zs;
+  const float dx = gamma(5) * (max_x + max_z);
+  const float dy = gamma(5) * (max_y + max_z);
+  const float de = 2.0f * (gamma(2) * max_x * max_y + dy * max_x + dx * max_y);
+  return 3.0f * (gamma(3) * max_e * max_zs + de * max_zs + dz * max_e) * std::fabs(1.0f / det);
+}
+
+/// The watertight test proper over [ray.tmin, ray.tmax]; fills `out` on a hit. A hit within
+/// the rounding error of t of the origin is rejected (`triangle_t_error`).
 inline bool triangle_test(const Ray& ray, const TrianglePre& p, Vec3 a, Vec3 b, Vec3 c,
                           TriangleCandidate& out) {
   // Arrays rather than Vec3::operator[] (a chain of selects): one indexed load each.
@@ -102,6 +128,9 @@ inline bool triangle_test(const Ray& ray, const TrianglePre& p, Vec3 a, Vec3 b, 
   const float az = p.sz * A[p.kz], bz = p.sz * B[p.kz], cz = p.sz * C[p.kz];
   const float t = (u * az + v * bz + w * cz) / det;
   if (!(t >= ray.tmin && t <= ray.tmax)) return false;
+  if (t <= triangle_t_error(ax, ay, bx, by, cx, cy, A[p.kz], B[p.kz], C[p.kz], p.sz, u, v, w,
+                            det))
+    return false;
   out = {t, u, v, w, det};
   return true;
 }

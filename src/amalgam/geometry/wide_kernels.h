@@ -214,16 +214,31 @@ inline unsigned triangle_test4(const TrianglePack4& p, const WideRay& r, float t
   const __m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
   const __m128 bad = _mm_or_ps(mixed, _mm_cmpeq_ps(det, zero));
   // t = (u az + v bz + w cz) / det with az = sz A[kz].
-  const __m128 num = _mm_add_ps(
-      _mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(sz, Z[0])), _mm_mul_ps(v, _mm_mul_ps(sz, Z[1]))),
-      _mm_mul_ps(w, _mm_mul_ps(sz, Z[2])));
+  const __m128 zs[3] = {_mm_mul_ps(sz, Z[0]), _mm_mul_ps(sz, Z[1]), _mm_mul_ps(sz, Z[2])};
+  const __m128 num = _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, zs[0]), _mm_mul_ps(v, zs[1])),
+                                _mm_mul_ps(w, zs[2]));
   const __m128 t = _mm_div_ps(num, det);
   // !(t >= tmin && t <= tmax) rejects: ordered compares, so a NaN t is rejected as well.
   const __m128 in =
       _mm_and_ps(_mm_cmpge_ps(t, _mm_set1_ps(tmin)), _mm_cmple_ps(t, _mm_set1_ps(tmax)));
   _mm_store_ps(out.t, t), _mm_store_ps(out.u, u), _mm_store_ps(out.v, v);
   _mm_store_ps(out.w, w), _mm_store_ps(out.det, det);
-  return static_cast<unsigned>(_mm_movemask_ps(_mm_andnot_ps(bad, in))) & lanes;
+  unsigned hits = static_cast<unsigned>(_mm_movemask_ps(_mm_andnot_ps(bad, in))) & lanes;
+  if (hits) {
+    // The scalar test's rejection of t within its rounding error, lane by lane on the same
+    // operands (triangle_t_error).
+    alignas(16) float x[3][kWideLanes], y[3][kWideLanes], z[3][kWideLanes];
+    for (int k = 0; k < 3; ++k)
+      _mm_store_ps(x[k], X[k]), _mm_store_ps(y[k], Y[k]), _mm_store_ps(z[k], Z[k]);
+    for (unsigned m = hits; m; m &= m - 1) {
+      const int i = std::countr_zero(m);
+      if (out.t[i] <= triangle_t_error(x[0][i], y[0][i], x[1][i], y[1][i], x[2][i], y[2][i],
+                                       z[0][i], z[1][i], z[2][i], pre.sz, out.u[i], out.v[i],
+                                       out.w[i], out.det[i]))
+        hits &= ~(1u << i);
+    }
+  }
+  return hits;
 #else
   Ray ray;
   ray.origin = {r.o[0], r.o[1], r.o[2]};

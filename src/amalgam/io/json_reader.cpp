@@ -152,7 +152,7 @@ double JsonReader::number(const JsonValue& v, double lo, double hi, const char* 
 
 double JsonReader::positive(const JsonValue& v) const {
   const bool huge = v.j.is_number() && v.j.get<double>() > kMaxCoordinate;
-  return number(v, 1e-30, kMaxCoordinate, huge ? "<= 1e18" : "> 0");
+  return number(v, 1e-30, kMaxCoordinate, huge ? "<= 1e12" : "> 0");
 }
 
 std::int64_t JsonReader::integer(const JsonValue& v, std::int64_t lo, std::int64_t hi) const {

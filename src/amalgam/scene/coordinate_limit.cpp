@@ -13,7 +13,7 @@ void check_extent(const Bbox& b, const std::string& where) {
     std::ostringstream reach;
     reach << m;
     throw InputError(where + ": the geometry reaches a coordinate of " + reach.str() +
-                     ", beyond the supported range [-1e18, 1e18]");
+                     ", beyond the supported range [-1e12, 1e12]");
   }
 }
 
