@@ -1,6 +1,9 @@
 #include "common.h"
 
+#include <cctype>
+#include <charconv>
 #include <sstream>
+#include <system_error>
 
 namespace amalgam::cli {
 
@@ -12,16 +15,26 @@ void CommonOptions::add_to(CLI::App& app) {
   app.add_option("--opacity", opacity, "stochastic (default) or deterministic")
       ->check(CLI::IsMember({"stochastic", "deterministic"}));
   app.add_option("--level", level, "scale-sensitive: render the amalgams met on level L")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_int());
   app.add_option("--footprint", footprint,
                  "scale-sensitive without --level: render an amalgam once it is smaller than K "
                  "pixels of ray footprint (default 1)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            try {
+              std::size_t end = 0;
+              const double x = std::stod(v, &end);
+              if (end == v.size() && x > 0.0 && x < 1e30) return "";
+            } catch (const std::exception&) {
+            }
+            return "expected a number > 0";
+          },
+          "K > 0"));
   app.add_option("--order", order, "sorted (default): nearest child first; unsorted: stored order")
       ->check(CLI::IsMember({"sorted", "unsorted"}));
-  app.add_option("--seed", seed, "seed of all randomness (default 0)");
+  app.add_option("--seed", seed, "seed of all randomness, 0 .. 2^64-1 (default 0)");
   app.add_option("--threads", threads, "worker threads (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_int());
 }
 
 void CommonOptions::finish() {
@@ -32,7 +45,7 @@ void CommonOptions::finish() {
   options.sorted = order == "sorted";
   options.level = level >= 0 ? std::optional<int>(level) : std::nullopt;
   options.footprint = footprint;
-  options.seed = static_cast<std::uint64_t>(seed);
+  options.seed = parse_seed(seed);
   options.threads = threads;
 }
 
@@ -40,6 +53,66 @@ Params CommonOptions::params() const {
   Params p(scene);
   for (const auto& s : sets) p.set(s);
   return p;
+}
+
+namespace {
+
+/// An integer in [lo, hi] written in plain decimal digits (no sign unless lo < 0, no exponent).
+CLI::Validator int_in(long long lo, long long hi, const std::string& what) {
+  return CLI::Validator(
+      [lo, hi, what](std::string& v) -> std::string {
+        long long x = 0;
+        const char* b = v.data();
+        const auto [p, ec] = std::from_chars(b, b + v.size(), x);
+        if (ec == std::errc() && p == b + v.size() && x >= lo && x <= hi) return "";
+        return "expected " + what;
+      },
+      what);
+}
+
+}  // namespace
+
+const CLI::Validator& positive_int() {
+  static const CLI::Validator v = int_in(1, 2147483647, "an integer >= 1");
+  return v;
+}
+
+const CLI::Validator& non_negative_int() {
+  static const CLI::Validator v = int_in(0, 2147483647, "an integer >= 0");
+  return v;
+}
+
+std::uint64_t parse_seed(const std::string& text) {
+  std::uint64_t x = 0;
+  const char* b = text.data();
+  const auto [p, ec] = std::from_chars(b, b + text.size(), x);
+  if (text.empty() || ec != std::errc() || p != b + text.size())
+    throw InputError("--seed " + one_line(text, 40) +
+                     ": expected an integer in [0, 18446744073709551615]");
+  return x;
+}
+
+std::uint64_t parse_bytes(const std::string& text, const std::string& option) {
+  std::uint64_t x = 0;
+  const char* b = text.data();
+  const char* e = b + text.size();
+  const auto [p, ec] = std::from_chars(b, e, x);
+  std::string suffix(p, e);
+  for (char& c : suffix) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  const std::string units = "KMGT";
+  int shift = 0;
+  bool ok = ec == std::errc() && p != b;
+  if (ok && !suffix.empty()) {
+    const auto u = units.find(suffix[0]);
+    ok = u != std::string::npos && (suffix.size() == 1 || suffix.substr(1) == "B" ||
+                                     suffix.substr(1) == "IB");
+    shift = ok ? 10 * (static_cast<int>(u) + 1) : 0;
+  }
+  if (ok && shift && x > (std::uint64_t{~0ull} >> shift)) ok = false;
+  if (!ok)
+    throw InputError(option + " " + one_line(text, 40) +
+                     ": expected a byte count, e.g. 512M or 8G (suffixes K, M, G, T)");
+  return x << shift;
 }
 
 Vec3 parse_vec3(const std::string& text, const std::string& option) {

@@ -20,7 +20,7 @@ struct CommonOptions {
   std::string order = "sorted";
   int level = -1;
   float footprint = 1.0f;
-  std::int64_t seed = 0;
+  std::string seed = "0";
   int threads = 0;
   RenderOptions options;
 
@@ -31,6 +31,19 @@ struct CommonOptions {
   Params params() const;
 };
 
+/// CLI11 validators with short messages of our own (CLI11's range messages print both bounds
+/// with 6 decimals: 390 characters for "positive").
+const CLI::Validator& positive_int();
+const CLI::Validator& non_negative_int();
+
+/// "--seed TEXT" as an unsigned 64-bit integer; throws InputError with the allowed range for
+/// anything else (a sign, an exponent, a fraction, 2^64 or more).
+std::uint64_t parse_seed(const std::string& text);
+
+/// A byte count: an integer with an optional suffix K, M, G or T (powers of 1024, optionally
+/// followed by B or iB, any case). Throws InputError naming `option` for anything else.
+std::uint64_t parse_bytes(const std::string& text, const std::string& option);
+
 /// Parses "x,y,z" into three floats; throws InputError naming the option.
 Vec3 parse_vec3(const std::string& text, const std::string& option);
 
@@ -39,7 +52,8 @@ struct RenderExtras {
   std::string out, stats, cost_image, checkpoint;
   bool resume = false;
   bool quiet = false;
-  std::uint64_t max_memory = 0;  ///< bytes; 0: the machine's physical memory
+  std::string max_memory;  ///< as given (parse_bytes); empty: the machine's physical memory
+  double checkpoint_every = 60.0;  ///< seconds between checkpoints during a render
 };
 
 int run_render(CommonOptions& common, const RenderExtras& extra);

@@ -22,20 +22,33 @@ int main(int argc, char** argv) {
   render->add_option("--cost-image", extras.cost_image,
                      "write intersection tests per pixel: false colour (.png) or raw (.exr/.pfm)");
   render->add_option("--width", render_opts.options.width, "image width (default 512)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::positive_int());
   render->add_option("--height", render_opts.options.height, "image height (default 512)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::positive_int());
   render->add_option("--spp", render_opts.options.spp, "samples per pixel (default 4)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::positive_int());
   render->add_option("--checkpoint", extras.checkpoint,
                      "checkpoint file written when interrupted (default: OUT.ckpt)");
   render->add_flag("--resume", extras.resume,
                    "continue an interrupted render from its checkpoint (same options)");
   render->add_flag("--quiet", extras.quiet, "no progress bar or summary on stderr");
   render->add_option("--max-memory", extras.max_memory,
-                     "fail early if the render needs more bytes than this (suffixes K, M, G; "
-                     "default: physical memory)")
-      ->transform(CLI::AsSizeValue(false));
+                     "fail early if the render needs more bytes than this (suffixes K, M, G, T; "
+                     "default: physical memory)");
+  render->add_option("--checkpoint-every", extras.checkpoint_every,
+                     "seconds between checkpoints while rendering (default 60; 0: after every "
+                     "pass of samples)")
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            try {
+              std::size_t end = 0;
+              const double x = std::stod(v, &end);
+              if (end == v.size() && x >= 0.0 && x <= 1e9) return "";
+            } catch (const std::exception&) {
+            }
+            return "expected seconds in [0, 1e9]";
+          },
+          "SECONDS"));
 
   cli::CommonOptions trace_opts;
   std::string origin, direction;

@@ -14,6 +14,7 @@
 #include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
 #include "amalgam/io/stats_json.h"
+#include "amalgam/util/atomic_file.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
 #include "amalgam/util/atomic_file.h"
@@ -25,28 +26,65 @@ namespace {
 
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
+std::atomic<int> g_signals{0};        ///< SIGINT/SIGTERM received
+std::atomic<bool> g_finishing{false};  ///< the render is done: its outputs are being written
 
+/// SIGINT/SIGTERM: the first stops the render at the next tile; the image so far and a
+/// checkpoint are then written. Once the outputs are being written, finishing them wins: a
+/// further signal is noted, and only a third in all ends the process at once, removing the
+/// temporary being written (nothing half-written stays).
 extern "C" void on_signal(int sig) {
   g_signal.store(sig);
   g_cancel.store(true);
+  const int n = g_signals.fetch_add(1) + 1;
+  if (g_finishing.load() && n >= 3) {
+    remove_temporary_from_signal_handler();
+    ::_exit(128 + sig);
+  }
 }
 
-/// Everything that determines the image except spp and threads: a checkpoint is only
-/// resumed under the same fingerprint.
-std::string fingerprint(const CommonOptions& c) {
+/// Everything that determines the image except spp and threads: the renderer options and the
+/// scene as loaded (content_hash: its geometry, lights and camera, or a builtin's parameters
+/// as applied). A checkpoint is only resumed under the same fingerprint.
+std::string fingerprint(const CommonOptions& c, const LoadedScene& scene) {
   const RenderOptions& o = c.options;
   std::ostringstream f;
-  f << c.scene;
-  std::vector<std::string> sets = c.sets;
-  std::sort(sets.begin(), sets.end());
-  for (const auto& s : sets) f << " --set " << s;
-  f << " --renderer " << c.renderer << " --opacity " << c.opacity << " --order " << c.order
+  f << c.scene << " (scene " << std::hex << content_hash(scene) << std::dec << ")"
+    << " --renderer " << c.renderer << " --opacity " << c.opacity << " --order " << c.order
     << " --seed " << o.seed << " --width " << o.width << " --height " << o.height;
   if (o.level)
     f << " --level " << *o.level;
   else
     f << " --footprint " << o.footprint;
   return f.str();
+}
+
+/// Checks every output path before any work: an image path must name a format we write, every
+/// path must be writable, and no two outputs may be the same file. Throws InputError.
+void check_outputs(const RenderExtras& e, const std::string& ckpt) {
+  if (!is_image_path(e.out))
+    throw InputError("--out " + e.out + ": unsupported image format (expected .png, .exr or .pfm)");
+  if (!e.cost_image.empty() && !is_image_path(e.cost_image))
+    throw InputError("--cost-image " + e.cost_image +
+                     ": unsupported image format (expected .png, .exr or .pfm)");
+  struct Output {
+    const char* option;
+    const std::string& path;
+  };
+  const Output outputs[] = {
+      {"--out", e.out}, {"--cost-image", e.cost_image}, {"--stats", e.stats}, {"--checkpoint", ckpt}};
+  std::vector<std::pair<std::string, const char*>> files;  // resolved regular files
+  for (const Output& o : outputs) {
+    if (o.path.empty()) continue;
+    check_writable(o.path);
+    const OutputTarget t = resolve_output(o.path);
+    if (t.kind != OutputTarget::Kind::kFile) continue;  // devices and "-" may be shared
+    const std::string key = std::filesystem::weakly_canonical(t.path).string();
+    for (const auto& [other, option] : files)
+      if (other == key)
+        throw InputError(std::string(o.option) + " " + o.path + ": the same file as " + option);
+    files.emplace_back(key, o.option);
+  }
 }
 
 std::uint64_t physical_memory() {
@@ -133,7 +171,13 @@ void write_cost_image(const std::string& path, const RenderOutput& r) {
 int run_render(CommonOptions& common, const RenderExtras& extra) {
   common.finish();
   const RenderOptions& o = common.options;
-  const std::uint64_t limit = extra.max_memory ? extra.max_memory : physical_memory();
+  const std::string ckpt = extra.checkpoint.empty() ? extra.out + ".ckpt" : extra.checkpoint;
+  check_outputs(extra, ckpt);
+  const std::uint64_t asked =
+      extra.max_memory.empty() ? 0 : parse_bytes(extra.max_memory, "--max-memory");
+  if (!extra.max_memory.empty() && asked == 0)
+    throw InputError("--max-memory 0: expected a positive byte count");
+  const std::uint64_t limit = asked ? asked : physical_memory();
   const std::uint64_t film = film_bytes(o);
   if (film > limit)
     throw InputError("--width " + std::to_string(o.width) + " --height " +
@@ -146,8 +190,7 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
                      human_bytes(film + scene_bytes(scene)) + ", more than --max-memory " +
                      human_bytes(limit));
 
-  const std::string ckpt = extra.checkpoint.empty() ? extra.out + ".ckpt" : extra.checkpoint;
-  const std::string fp = fingerprint(common);
+  const std::string fp = fingerprint(common, scene);
   FilmState state;
   if (extra.resume) {
     if (!std::filesystem::exists(ckpt)) throw InputError(ckpt + ": no checkpoint to resume from");
@@ -157,8 +200,12 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
                        " samples per pixel, more than --spp " + std::to_string(o.spp));
   }
 
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
   Progress progress(o.spp, !extra.quiet);
   auto last_checkpoint = std::chrono::steady_clock::now();
   RenderControl control;
@@ -166,28 +213,44 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   control.on_pass = [&](const FilmState& st) {
     progress.update(st.spp_done);
     const auto now = std::chrono::steady_clock::now();
-    if (st.spp_done < o.spp && now - last_checkpoint > std::chrono::seconds(60)) {
+    if (st.spp_done < o.spp &&
+        std::chrono::duration<double>(now - last_checkpoint).count() >= extra.checkpoint_every) {
       write_checkpoint(ckpt, fp, st);  // survives even a SIGKILL
       last_checkpoint = now;
     }
   };
   RenderOutput r = render(scene, o, &state, control);
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
+  // The work is done: writing its results wins over further signals (on_signal).
+  g_finishing.store(true);
 
+  // Each output is written even when another fails; the ones missing are named at the end.
+  std::vector<std::string> failed;
+  auto attempt = [&](const std::string& what, auto&& write) {
+    try {
+      write();
+    } catch (const std::exception& e) {
+      std::cerr << "amalgam: " << e.what() << "\n";
+      failed.push_back(what);
+    }
+  };
   if (r.spp > 0) {
-    write_image(extra.out, r.width, r.height, r.image);
-    if (!extra.cost_image.empty()) write_cost_image(extra.cost_image, r);
+    attempt(extra.out, [&] { write_image(extra.out, r.width, r.height, r.image); });
+    if (!extra.cost_image.empty())
+      attempt(extra.cost_image, [&] { write_cost_image(extra.cost_image, r); });
   }
   const std::string json =
       stats_json(scene, o, r.counters, r.per_primary, r.seconds).dump(2) + "\n";
-  if (extra.stats == "-")
-    std::cout << json;
-  else if (!extra.stats.empty())
-    write_file_atomic(extra.stats, json);
+  if (!extra.stats.empty()) attempt(extra.stats, [&] { write_file_atomic(extra.stats, json); });
+  if (r.interrupted || !failed.empty())
+    attempt(ckpt, [&] { write_checkpoint(ckpt, fp, state); });
+  if (!failed.empty()) {
+    std::cerr << "amalgam: not written: ";
+    for (std::size_t i = 0; i < failed.size(); ++i) std::cerr << (i ? ", " : "") << failed[i];
+    std::cerr << "\n";
+    return 1;
+  }
 
   if (r.interrupted) {
-    write_checkpoint(ckpt, fp, state);
     const int sig = g_signal.load();
     std::cerr << "amalgam: interrupted by " << (sig == SIGTERM ? "SIGTERM" : "SIGINT") << ": "
               << (r.spp > 0 ? extra.out : std::string("no image")) << " holds " << r.spp << " of "

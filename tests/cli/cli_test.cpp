@@ -128,12 +128,6 @@ TEST(Cli, BadInputExitsTwoWithOneLineAndNoOutput) {
   fs::remove_all(d);
 }
 
-TEST(Cli, UnwritableOutputIsARuntimeFailureWithoutPartialFiles) {
-  const CliRun r = run("render builtin:line --width 4 --height 4 --out /no/such/dir/x.png");
-  EXPECT_EQ(r.status, 1);
-  EXPECT_FALSE(fs::exists("/no/such/dir/x.png"));
-}
-
 // Meshes are imported by a helper process (AMALGAM_IMPORT_HELPER names it; here a stand-in,
 // tests/io/fake_importer.cpp, that aborts as Assimp 5.2 does on some corrupt files): its crash
 // is bad input, one line, exit 2; a helper that cannot be started is a runtime failure, exit 1.

@@ -78,7 +78,7 @@ TEST(AtomicFile, MissingDirectoryIsARuntimeErrorNamingThePath) {
   TempDir dir("missing");
   const std::string path = (dir.path() / "no_such_dir" / "out.json").string();
   EXPECT_EQ(runtime_error_of([&] { write_file_atomic(path, "{}"); }),
-            path + ": cannot open for writing: No such file or directory");
+            path + ": the directory " + (dir.path() / "no_such_dir").string() + " does not exist");
   EXPECT_TRUE(dir.entries().empty());
 }
 

@@ -73,4 +73,10 @@ void Params::check_all_used() const {
     if (!used_.count(k)) throw InputError(scene_ + ": unknown parameter '" + k + "' in --set");
 }
 
+std::string Params::applied() const {
+  std::string out;
+  for (const auto& [k, v] : values_) out += (out.empty() ? "" : " ") + k + "=" + v;
+  return out;
+}
+
 }  // namespace amalgam

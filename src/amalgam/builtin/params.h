@@ -27,6 +27,9 @@ class Params {
                          const std::set<std::string>& allowed) const;
   /// Throws InputError for any key never read by a get_*.
   void check_all_used() const;
+  /// The parameters as applied (a later --set of a key replaces an earlier one), sorted by
+  /// key: "k1=v1 k2=v2".
+  std::string applied() const;
 
  private:
   std::string scene_;

@@ -2,7 +2,11 @@
 
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <sstream>
+#include <string_view>
+
+#include "amalgam/math/random.h"
 
 #include "amalgam/util/atomic_file.h"
 #include "amalgam/util/error.h"
@@ -10,7 +14,22 @@
 namespace amalgam {
 namespace {
 
-constexpr char kMagic[] = "AMALGAM-CHECKPOINT-1";
+constexpr char kMagic[] = "AMALGAM-CHECKPOINT-2";
+
+/// Checksum of a checkpoint's bytes (everything before the checksum itself): 64-bit words
+/// through hash_combine, so any flipped bit changes it (with probability 1 - 2^-64).
+std::uint64_t checksum(std::string_view bytes) {
+  std::uint64_t h = 0xc4ec4ec4ull;
+  std::size_t i = 0;
+  for (; i + 8 <= bytes.size(); i += 8) {
+    std::uint64_t w;
+    std::memcpy(&w, bytes.data() + i, 8);
+    h = hash_combine(h, w);
+  }
+  std::uint64_t tail = bytes.size();
+  for (; i < bytes.size(); ++i) tail = tail * 257 + static_cast<unsigned char>(bytes[i]);
+  return hash_combine(h, tail);
+}
 
 template <class T>
 void put(std::ostream& out, const T& v) {
@@ -41,16 +60,27 @@ void write_checkpoint(const std::string& path, const std::string& fingerprint,
   st.per_primary.for_each([&](std::uint64_t, std::uint64_t) { ++distinct; });
   put(out, distinct);
   st.per_primary.for_each([&](std::uint64_t v, std::uint64_t c) { put(out, v), put(out, c); });
-  write_file_atomic(path, out.str());
+  std::string bytes = out.str();
+  const std::uint64_t sum = checksum(bytes);
+  bytes.append(reinterpret_cast<const char*>(&sum), sizeof sum);
+  write_file_atomic(path, bytes);
 }
 
 FilmState read_checkpoint(const std::string& path, const std::string& fingerprint) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open checkpoint: " + std::strerror(errno));
-  char magic[sizeof kMagic] = {};
-  in.read(magic, sizeof magic);
-  if (!in || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
-    throw InputError(path + ": not an amalgam checkpoint");
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw InputError(path + ": cannot open checkpoint: " + std::strerror(errno));
+  std::string bytes{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+  if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    throw InputError(path + ": not an amalgam checkpoint (or one of an older version)");
+  std::uint64_t stored = 0;
+  if (bytes.size() < sizeof kMagic + sizeof stored)
+    throw InputError(path + ": checkpoint is truncated");
+  std::memcpy(&stored, bytes.data() + bytes.size() - sizeof stored, sizeof stored);
+  bytes.resize(bytes.size() - sizeof stored);
+  if (checksum(bytes) != stored)
+    throw InputError(path + ": checkpoint is damaged (checksum mismatch): delete it to start over");
+  std::istringstream in(bytes, std::ios::binary);
+  in.seekg(sizeof kMagic);
   std::uint64_t len = 0;
   get(in, len);
   if (!in || len > (1u << 20)) throw InputError(path + ": corrupt checkpoint header");
@@ -79,7 +109,10 @@ FilmState read_checkpoint(const std::string& path, const std::string& fingerprin
     get(in, v), get(in, c);
     st.per_primary.add(v, c);
   }
-  if (!in) throw InputError(path + ": checkpoint is truncated");
+  if (!in || in.peek() != std::char_traits<char>::eof())
+    throw InputError(path + ": checkpoint is truncated or has trailing data");
+  for (const Vec3& v : st.sum)
+    if (!is_finite(v)) throw InputError(path + ": checkpoint holds a non-finite pixel sum");
   return st;
 }
 

@@ -27,6 +27,15 @@ Format image_format(const std::string& path) {
 
 }  // namespace
 
+bool is_image_path(const std::string& path) {
+  try {
+    (void)image_format(path);
+    return true;
+  } catch (const ImageIoError&) {
+    return false;
+  }
+}
+
 void write_image(const std::string& path, int width, int height,
                  const std::vector<Vec3>& linear_rgb) {
   const Format format = image_format(path);

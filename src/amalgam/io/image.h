@@ -20,6 +20,9 @@ struct ImageIoError : RuntimeError {
   using RuntimeError::RuntimeError;
 };
 
+/// Whether `path` names an image format write_image writes (.png, .pfm, .exr, any case).
+bool is_image_path(const std::string& path);
+
 /// Writes a width x height image; pixel (x, y) is linear_rgb[y * width + x], y = 0 the top row.
 /// The format follows the extension of `path` (case-insensitive):
 ///   .png  8-bit sRGB (values clamped to [0, 1], sRGB transfer function, rounded);

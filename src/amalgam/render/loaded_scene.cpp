@@ -1,6 +1,9 @@
 #include "amalgam/render/loaded_scene.h"
 
+#include <bit>
 #include <chrono>
+
+#include "amalgam/math/random.h"
 
 namespace amalgam {
 
@@ -9,10 +12,65 @@ LoadedScene load_builtin(const std::string& spec, const Params& params) {
   BuiltinScene b = make_builtin(spec, params);
   LoadedScene s;
   s.name = std::move(b.name);
+  s.params = params.applied();
   std::visit([&](auto& h) { s.hierarchy = std::move(h); }, b.hierarchy);
   s.env = std::move(b.env);
   s.load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return s;
+}
+
+namespace {
+
+/// Accumulates a hash of values, field by field (never padding bytes).
+struct Hasher {
+  std::uint64_t h = 0x9e3779b97f4a7c15ull;
+  void add(std::uint64_t v) { h = hash_combine(h, v); }
+  void add(float f) { add(static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(f))); }
+  void add(Vec3 v) { add(v.x), add(v.y), add(v.z); }
+  void add(const std::string& s) {
+    add(static_cast<std::uint64_t>(s.size()));
+    for (unsigned char c : s) add(static_cast<std::uint64_t>(c));
+  }
+  void add(const Surface& m) { add(m.colour), add(m.reflectance), add(m.shininess); }
+  void add(const Primitive& p) {
+    add(static_cast<std::uint64_t>(p.kind)), add(static_cast<std::uint64_t>(p.material));
+    add(p.a), add(p.b), add(p.c), add(p.radius);
+  }
+  void add(const ExplicitHierarchy& e) {
+    add(static_cast<std::uint64_t>(e.prims.size()));
+    for (const Primitive& p : e.prims) add(p);
+    add(static_cast<std::uint64_t>(e.materials.size()));
+    for (const Surface& m : e.materials) add(m);
+  }
+};
+
+}  // namespace
+
+std::uint64_t content_hash(const LoadedScene& scene) {
+  Hasher h;
+  h.add(scene.name);
+  h.add(scene.params);
+  h.add(static_cast<std::uint64_t>(scene.env.lights.size()));
+  for (const Light& l : scene.env.lights) {
+    h.add(static_cast<std::uint64_t>(l.kind));
+    h.add(l.position), h.add(l.direction), h.add(l.intensity);
+  }
+  const Camera& c = scene.env.camera;
+  h.add(c.position), h.add(c.look_at), h.add(c.up), h.add(c.vfov_deg);
+  h.add(scene.env.background);
+  h.add(static_cast<std::uint64_t>(scene.hierarchy.index()));
+  if (const auto* e = std::get_if<ExplicitHierarchy>(&scene.hierarchy)) h.add(*e);
+  if (const auto* in = std::get_if<InstancedHierarchy>(&scene.hierarchy)) {
+    h.add(static_cast<std::uint64_t>(in->meshes.size()));
+    for (const ExplicitHierarchy& m : in->meshes) h.add(m);
+    h.add(static_cast<std::uint64_t>(in->instances.size()));
+    for (const auto& d : in->instances) {
+      h.add(static_cast<std::uint64_t>(d.mesh));
+      for (const auto& row : d.to_world.m)
+        for (float v : row) h.add(v);
+    }
+  }
+  return h.h;
 }
 
 }  // namespace amalgam

@@ -3,6 +3,7 @@
 /// environment. Made by the front end's loader (load/load_scene.h) or, for the builtin scenes
 /// alone, by `load_builtin`.
 
+#include <cstdint>
 #include <string>
 #include <variant>
 
@@ -23,11 +24,20 @@ struct LoadedScene {
   Environment env;
   double load_seconds = 0.0;
   double build_seconds = 0.0;
+  /// For builtin scenes: the parameters as applied (Params::applied); part of content_hash.
+  std::string params{};
 
   HierarchyInfo info() const {
     return std::visit([](const auto& h) { return h.info(); }, hierarchy);
   }
 };
+
+/// A 64-bit hash of everything the scene renders: its lights, camera and background, and its
+/// geometry (for stored hierarchies every primitive, material and instance transform, field
+/// by field; for the builtin scenes their name and parameters as applied, which determine
+/// them). Two scenes with the same hash render the same image (up to hash collisions): what a
+/// checkpoint is resumed against.
+std::uint64_t content_hash(const LoadedScene& scene);
 
 /// A builtin scene (builtin/catalog.h) ready to render; sets load_seconds.
 LoadedScene load_builtin(const std::string& spec, const Params& params);

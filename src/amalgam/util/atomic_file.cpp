@@ -1,10 +1,15 @@
 #include "amalgam/util/atomic_file.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#include <climits>
+#include <cstring>
 
 #include <atomic>
 #include <cerrno>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <system_error>
@@ -20,6 +25,21 @@ std::string errno_text(int err) {
 
 std::atomic<unsigned long> g_counter{0};  ///< tells apart the temporaries of one process
 
+/// The temporary being written (for remove_temporary_from_signal_handler): a fixed buffer,
+/// published by `g_temp_active` after it is filled.
+char g_temp_path[PATH_MAX];
+std::atomic<int> g_temp_active{0};
+
+bool write_fd(int fd, const char* p, std::size_t n) {
+  while (n > 0) {
+    const ssize_t w = ::write(fd, p, n);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) return false;
+    p += w, n -= static_cast<std::size_t>(w);
+  }
+  return true;
+}
+
 /// Makes a completed rename durable (best effort: a directory that cannot be opened or synced
 /// does not fail a write whose data is already safely on disk).
 void sync_directory_of(const std::string& path) {
@@ -32,20 +52,91 @@ void sync_directory_of(const std::string& path) {
 
 }  // namespace
 
-AtomicFile::AtomicFile(const std::string& destination)
-    : destination_(destination),
-      temp_(destination + ".tmp-" + std::to_string(::getpid()) + "-" +
-            std::to_string(g_counter.fetch_add(1))) {
+OutputTarget resolve_output(const std::string& path) {
+  OutputTarget t;
+  if (path == "-") {
+    t.kind = OutputTarget::Kind::kStdout;
+    t.path = path;
+    return t;
+  }
+  if (path.empty()) throw InputError("an output path is empty");
+  fs::path p(path);
+  std::error_code ec;
+  for (int hops = 0; fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
+    if (hops == 40) throw InputError(path + ": too many levels of symbolic links");
+    const fs::path target = fs::read_symlink(p, ec);
+    if (ec) throw InputError(path + ": cannot read the symbolic link: " + ec.message());
+    p = target.is_absolute() ? target : p.parent_path() / target;
+  }
+  const fs::file_status st = fs::status(p, ec);
+  t.path = p.string();
+  if (fs::exists(st)) {
+    if (fs::is_directory(st)) throw InputError(path + ": is a directory");
+    t.kind = fs::is_regular_file(st) ? OutputTarget::Kind::kFile : OutputTarget::Kind::kSpecial;
+    return t;
+  }
+  const fs::path parent = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+  const fs::file_status ps = fs::status(parent, ec);
+  if (!fs::exists(ps)) throw InputError(path + ": the directory " + parent.string() + " does not exist");
+  if (!fs::is_directory(ps)) throw InputError(path + ": " + parent.string() + " is not a directory");
+  t.kind = OutputTarget::Kind::kFile;
+  return t;
+}
+
+void check_writable(const std::string& path) {
+  const OutputTarget t = resolve_output(path);
+  if (t.kind == OutputTarget::Kind::kStdout) return;
+  const bool exists = fs::exists(fs::path(t.path));
+  const fs::path parent = fs::path(t.path).parent_path();
+  const std::string probe =
+      t.kind == OutputTarget::Kind::kSpecial || (exists && t.kind != OutputTarget::Kind::kFile)
+          ? t.path
+          : (parent.empty() ? std::string(".") : parent.string());
+  // A regular file is replaced through its directory; a special file is written through.
+  if (::access(probe.c_str(), W_OK) != 0)
+    throw InputError(path + ": cannot be written: " + errno_text(errno));
+}
+
+void remove_temporary_from_signal_handler() noexcept {
+  if (g_temp_active.load()) ::unlink(g_temp_path);
+}
+
+AtomicFile::AtomicFile(const std::string& destination) {
+  try {
+    target_ = resolve_output(destination);
+  } catch (const InputError& e) {  // as a write failure: the caller names the path
+    const std::string what = e.what();
+    throw RuntimeError(what.substr(what.find(": ") == std::string::npos ? 0 : what.find(": ") + 2));
+  }
+  if (target_.kind != OutputTarget::Kind::kFile) {
+    fp_ = ::open_memstream(&memory_, &memory_size_);
+    if (!fp_) throw RuntimeError("cannot allocate the output buffer: " + errno_text(errno));
+    return;
+  }
+  temp_ = target_.path + ".tmp-" + std::to_string(::getpid()) + "-" +
+          std::to_string(g_counter.fetch_add(1));
+  if (temp_.size() < sizeof g_temp_path) {
+    std::memcpy(g_temp_path, temp_.c_str(), temp_.size() + 1);
+    g_temp_active.store(1);
+  }
   fp_ = std::fopen(temp_.c_str(), "wb");
-  if (!fp_) throw RuntimeError("cannot open for writing: " + errno_text(errno));
+  if (!fp_) {
+    g_temp_active.store(0);
+    throw RuntimeError("cannot open for writing: " + errno_text(errno));
+  }
+  // A replaced file keeps its permission bits.
+  struct stat old;
+  if (::stat(target_.path.c_str(), &old) == 0) (void)::fchmod(::fileno(fp_), old.st_mode & 07777);
 }
 
 AtomicFile::~AtomicFile() {
   if (fp_) std::fclose(fp_);
-  if (!committed_) {
+  std::free(memory_);
+  if (!committed_ && !temp_.empty()) {
     std::error_code ec;
     fs::remove(temp_, ec);
   }
+  if (!temp_.empty()) g_temp_active.store(0);
 }
 
 void AtomicFile::write(const void* data, std::size_t n) {
@@ -55,16 +146,36 @@ void AtomicFile::write(const void* data, std::size_t n) {
 
 void AtomicFile::commit() {
   if (std::fflush(fp_) != 0) throw RuntimeError("write failed: " + errno_text(errno));
+  if (target_.kind != OutputTarget::Kind::kFile) {  // the whole contents made: write through
+    if (std::ferror(fp_)) throw RuntimeError("write failed");
+    std::FILE* fp = fp_;
+    fp_ = nullptr;
+    std::fclose(fp);  // memory_ and memory_size_ now hold the contents
+    if (target_.kind == OutputTarget::Kind::kStdout) {
+      std::fflush(stdout);
+      if (!write_fd(1, memory_, memory_size_))
+        throw RuntimeError("write to standard output failed: " + errno_text(errno));
+    } else {
+      const int fd = ::open(target_.path.c_str(), O_WRONLY | O_CLOEXEC);
+      if (fd < 0) throw RuntimeError("cannot open for writing: " + errno_text(errno));
+      const bool ok = write_fd(fd, memory_, memory_size_);
+      const int err = errno;
+      ::close(fd);
+      if (!ok) throw RuntimeError("write failed: " + errno_text(err));
+    }
+    committed_ = true;
+    return;
+  }
   if (std::ferror(fp_)) throw RuntimeError("write failed");
   if (::fsync(::fileno(fp_)) != 0) throw RuntimeError("cannot sync to disk: " + errno_text(errno));
   std::FILE* fp = fp_;
   fp_ = nullptr;
   if (std::fclose(fp) != 0) throw RuntimeError("write failed on close: " + errno_text(errno));
   std::error_code ec;
-  fs::rename(temp_, destination_, ec);
+  fs::rename(temp_, target_.path, ec);
   if (ec) throw RuntimeError("cannot rename temporary file into place: " + ec.message());
   committed_ = true;
-  sync_directory_of(destination_);
+  sync_directory_of(target_.path);
 }
 
 namespace detail {

@@ -2,6 +2,12 @@
 /// \file Atomic file output: every file amalgam writes (images, stats JSON, checkpoints,
 /// experiment reports) goes through `write_atomically`, so a destination is either left
 /// untouched or holds the complete new contents, never a half-written file.
+///
+/// What is replaced is only ever a regular file or a new path: a symbolic link is followed and
+/// its final target replaced (the link stays); a character or block device, a FIFO or a socket
+/// (`/dev/null`, `/dev/stdout`, a pipe) is written through, never renamed over; "-" is standard
+/// output. Those are written from memory once the whole contents are made, so a failure while
+/// making them writes nothing.
 
 #include <cstddef>
 #include <cstdio>
@@ -16,6 +22,30 @@
 namespace amalgam {
 
 class AtomicFile;
+
+/// Where an output path leads.
+struct OutputTarget {
+  enum class Kind : unsigned char {
+    kFile,     ///< a regular file or a new path: written to a temporary, renamed onto `path`
+    kSpecial,  ///< a device, FIFO or socket: written through
+    kStdout,   ///< "-"
+  };
+  Kind kind = Kind::kFile;
+  std::string path;  ///< symbolic links resolved
+};
+
+/// Resolves `path` (following symbolic links, at most 40) and classifies it. Throws InputError
+/// naming the path when it can never be written: a directory, a parent that is missing or not
+/// a directory, a symbolic link loop.
+OutputTarget resolve_output(const std::string& path);
+
+/// Checks before any work that `path` can be written: resolve_output, then write permission
+/// on the file (or, for a new path, its directory). Throws InputError naming the path.
+void check_writable(const std::string& path);
+
+/// Removes the temporary file being written, if any, with async-signal-safe calls only: for a
+/// signal handler that ends the process during a write (no temporary may be left behind).
+void remove_temporary_from_signal_handler() noexcept;
 
 namespace detail {
 /// write_atomically without the throw: nullopt on success, else the one-line reason of the
@@ -38,7 +68,8 @@ class AtomicFile {
   /// The open C stream, for libraries that write through one (libpng, OpenEXR). Errors on it
   /// are caught when write_atomically flushes it.
   std::FILE* stream() const { return fp_; }
-  /// The temporary's path: `<destination>.tmp-<pid>-<n>`, in the destination's directory.
+  /// The temporary's path: `<destination>.tmp-<pid>-<n>`, in the destination's directory
+  /// (empty when the destination is written through from memory: a device, FIFO or "-").
   const std::string& temp_path() const { return temp_; }
 
  private:
@@ -51,14 +82,18 @@ class AtomicFile {
   /// Flushes, fsyncs and closes the temporary, then renames it onto the destination.
   void commit();
 
-  std::string destination_, temp_;
+  OutputTarget target_;
+  std::string temp_;
   std::FILE* fp_ = nullptr;
+  char* memory_ = nullptr;  ///< open_memstream's buffer (special targets)
+  std::size_t memory_size_ = 0;
   bool committed_ = false;
 };
 
 /// Writes `path` atomically: `body` writes a temporary file in the same directory (so the
 /// rename never crosses file systems), which is then flushed, fsynced and renamed onto `path`
-/// (replacing any existing file). On any failure, of the body or of the file, the temporary is
+/// (replacing an existing regular file, keeping its permission bits); a special target is
+/// written through (see the file comment). On any failure, of the body or of the file, the temporary is
 /// removed and an `Error` (RuntimeError or a kind derived from it) is thrown whose what() is
 /// one line, "<path>: <reason>"; exceptions thrown by `body` give their what() as the reason.
 template <class Error = RuntimeError>

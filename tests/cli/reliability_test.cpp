@@ -1,0 +1,162 @@
+// Outputs: never replace what is not ours (devices, FIFOs, the target of a symbolic link, not
+// the link), check every output before any work, refuse two outputs on one file; numbers out
+// of range are refused, not clamped (README, "Reliability").
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <iterator>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Dir {
+  fs::path path;
+  explicit Dir(const std::string& name)
+      : path(fs::temp_directory_path() / ("amalgam-rel-" + name + "-" + std::to_string(getpid()))) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~Dir() { fs::remove_all(path); }
+  std::string operator/(const std::string& f) const { return (path / f).string(); }
+};
+
+std::string slurp(const std::string& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+struct CliResult {
+  int status;
+  std::string err;
+  double seconds;
+};
+
+CliResult amalgam(const std::string& args) {
+  const std::string err = fs::temp_directory_path() / ("amalgam-rel-err-" + std::to_string(getpid()));
+  const auto t0 = std::chrono::steady_clock::now();
+  const int st = std::system((std::string(AMALGAM_BINARY) + " " + args + " 2>" + err).c_str());
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  CliResult r{WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st), slurp(err), s};
+  fs::remove(err);
+  return r;
+}
+
+const std::string kSmall = "render builtin:prisms --set depth=3 --width 8 --height 8 --spp 1 --quiet";
+/// A render that takes minutes: an output check that comes only after the work would show.
+const std::string kLong = "render builtin:prisms --set depth=8 --width 512 --height 512 --spp 10000";
+
+TEST(Outputs, DevicesAndFifosAreWrittenThroughNeverReplaced) {
+  Dir d("dev");
+  // A character device like /dev/null, made here (as root) rather than touching /dev; as
+  // another user, /dev/null itself (which a rename could not replace anyway).
+  std::string null = d / "null";
+  if (::mknod(null.c_str(), S_IFCHR | 0666, makedev(1, 3)) != 0) null = "/dev/null";
+  const CliResult r = amalgam(kSmall + " --out " + (d / "x.png") + " --stats " + null + " --cost-image " +
+                        (d / "c.png"));
+  EXPECT_EQ(r.status, 0) << r.err;
+  struct stat st {};
+  ASSERT_EQ(::stat(null.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode)) << null << " is no longer a character device";
+  // A FIFO: the JSON arrives through it, and it stays a FIFO.
+  const std::string fifo = d / "fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  auto reader = std::async(std::launch::async, [&] { return slurp(fifo); });
+  const CliResult f = amalgam(kSmall + " --out " + (d / "y.png") + " --stats " + fifo);
+  EXPECT_EQ(f.status, 0) << f.err;
+  const std::string json = reader.get();
+  EXPECT_NE(json.find("\"tests\""), std::string::npos) << json;
+  ASSERT_EQ(::stat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+}
+
+TEST(Outputs, ASymbolicLinkKeepsPointingAtTheNewContents) {
+  Dir d("link");
+  const std::string target = d / "target.png", link = d / "link.png";
+  std::ofstream(target) << "old";
+  fs::create_symlink(target, link);
+  const CliResult r = amalgam(kSmall + " --out " + link);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(fs::read_symlink(link), target);
+  EXPECT_EQ(slurp(target).substr(1, 3), "PNG") << "the target holds the new image";
+}
+
+TEST(Outputs, EveryOutputIsCheckedBeforeAnyWork) {
+  Dir d("check");
+  fs::create_directories(d.path / "adir");
+  std::ofstream(d / "afile") << "x";
+  struct Case {
+    std::string args, message;
+  };
+  const Case cases[] = {
+      {"--out " + (d / "x.bmp"), "unsupported image format"},
+      {"--out " + (d / "adir"), "unsupported image format"},
+      {"--out " + (d / "adir.png/"), ""},
+      {"--out " + (d / "none/x.png"), "does not exist"},
+      {"--out " + (d / "afile/x.png"), "is not a directory"},
+      {"--out " + (d / "x.png") + " --stats " + (d / "none/s.json"), "does not exist"},
+      {"--out " + (d / "x.png") + " --stats " + (d / "adir"), "is a directory"},
+      {"--out " + (d / "x.png") + " --cost-image " + (d / "c.bmp"), "unsupported image format"},
+      {"--out " + (d / "x.png") + " --checkpoint " + (d / "none/c.ckpt"), "does not exist"},
+  };
+  for (const Case& c : cases) {
+    const CliResult r = amalgam(kLong + " " + c.args);
+    EXPECT_EQ(r.status, 2) << c.args << ": " << r.err;
+    EXPECT_LT(r.seconds, 5.0) << c.args << ": refused only after rendering";
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(d / "x.png"));
+}
+
+TEST(Outputs, TwoOutputsOnOneFileAreRefused) {
+  Dir d("collide");
+  const std::string x = d / "x.png";
+  fs::create_symlink(x, d / "alias.json");
+  for (const std::string& other :
+       {"--stats " + x, "--cost-image " + x, "--checkpoint " + x, "--stats " + (d / "alias.json"),
+        "--stats " + (d / "sub/../x.png")}) {
+    fs::create_directories(d.path / "sub");
+    const CliResult r = amalgam(kLong + " --out " + x + " " + other);
+    EXPECT_EQ(r.status, 2) << other << ": " << r.err;
+    EXPECT_NE(r.err.find("the same file as --out"), std::string::npos) << other << ": " << r.err;
+    EXPECT_LT(r.seconds, 5.0) << other;
+  }
+  EXPECT_FALSE(fs::exists(x));
+}
+
+TEST(Numbers, OutOfRangeIsRefusedWithTheRangeNotClamped) {
+  Dir d("numbers");
+  const std::string out = " --out " + (d / "x.png");
+  for (const char* seed : {"18446744073709551616", "1e23", "-1", "2^63", "0x10", "1.5", ""}) {
+    const CliResult r = amalgam(kSmall + out + " --seed '" + seed + "'");
+    EXPECT_EQ(r.status, 2) << seed << ": " << r.err;
+    EXPECT_NE(r.err.find("expected an integer in [0, 18446744073709551615]"), std::string::npos)
+        << seed << ": " << r.err;
+  }
+  EXPECT_EQ(amalgam(kSmall + out + " --seed 18446744073709551615").status, 0);
+  for (const char* mem : {"-1", "0", "12Q", "1e9", "99999999999T"}) {
+    const CliResult r = amalgam(kSmall + out + " --max-memory " + mem);
+    EXPECT_EQ(r.status, 2) << mem << ": " << r.err;
+  }
+  EXPECT_EQ(amalgam(kSmall + out + " --max-memory 2G").status, 0);
+  for (const char* bad : {"--width 0", "--height -3", "--spp 1.5", "--footprint 0", "--threads -1",
+                          "--level -1", "--checkpoint-every -1"}) {
+    const CliResult r = amalgam(kSmall + out + " " + bad);
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
+    EXPECT_LT(r.err.size(), 160u) << bad << ": a short line, not CLI11's range dump: " << r.err;
+  }
+}
+
+}  // namespace
