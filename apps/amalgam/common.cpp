@@ -14,9 +14,9 @@ void CommonOptions::add_to(CLI::App& app) {
       ->check(CLI::IsMember({"scale-sensitive", "traditional"}));
   app.add_option("--opacity", opacity, "stochastic (default) or deterministic")
       ->check(CLI::IsMember({"stochastic", "deterministic"}));
-  app.add_option("--level", level, "scale-sensitive: render the amalgams met on level L")
+  level_option = app.add_option("--level", level, "scale-sensitive: render the amalgams met on level L")
       ->check(non_negative_int());
-  app.add_option("--footprint", footprint,
+  footprint_option = app.add_option("--footprint", footprint,
                  "scale-sensitive without --level: render an amalgam once it is smaller than K "
                  "pixels of ray footprint (default 1)")
       ->check(CLI::Validator(
@@ -38,6 +38,13 @@ void CommonOptions::add_to(CLI::App& app) {
 }
 
 void CommonOptions::finish() {
+  const bool level_given = level_option && level_option->count() > 0;
+  const bool footprint_given = footprint_option && footprint_option->count() > 0;
+  if (level_given && footprint_given)
+    throw InputError("--level and --footprint: give one (a fixed level, or render by footprint)");
+  if (renderer == "traditional" && (level_given || footprint_given))
+    throw InputError(std::string("--renderer traditional renders no amalgam: ") +
+                     (level_given ? "--level" : "--footprint") + " does not apply");
   options.renderer =
       renderer == "traditional" ? RendererKind::kTraditional : RendererKind::kScaleSensitive;
   options.opacity =

@@ -23,6 +23,8 @@ struct CommonOptions {
   std::string seed = "0";
   int threads = 0;
   RenderOptions options;
+  CLI::Option* level_option = nullptr;
+  CLI::Option* footprint_option = nullptr;
 
   /// Registers SCENE, --set and the renderer options of CONTRACT.md on `app`.
   void add_to(CLI::App& app);

@@ -159,4 +159,45 @@ TEST(Numbers, OutOfRangeIsRefusedWithTheRangeNotClamped) {
   }
 }
 
+TEST(BadInput, OneClearLineForEmptyBinaryLongOrLoopingInput) {
+  Dir d("input");
+  std::ofstream(d / "empty.json") << "";
+  std::ofstream(d / "binary.json", std::ios::binary) << std::string("{\"x\xff\xfe\x01", 6);
+  std::ofstream(d / "camera.json") << R"({"camera": 42})";
+  std::ofstream(d / "long.json") << "{\"" << std::string(100000, 'k') << "\": 1}";
+  fs::create_symlink(d / "loop2.json", d.path / "loop1.json");
+  fs::create_symlink(d / "loop1.json", d.path / "loop2.json");
+  struct Case {
+    std::string file, message;
+  };
+  const Case cases[] = {{"empty.json", "empty file"},
+                        {"binary.json", "not UTF-8 text"},
+                        {"camera.json", "/camera: expected an object"},
+                        {"long.json", "unknown key"},
+                        {"loop1.json", "symbolic links"}};
+  for (const Case& c : cases) {
+    const CliResult r = amalgam("render " + (d / c.file) + " --out " + (d / "x.png"));
+    EXPECT_EQ(r.status, 2) << c.file << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.file << ": " << r.err.substr(0, 300);
+    EXPECT_LT(r.err.size(), 600u) << c.file << ": the line quotes the input whole";
+  }
+}
+
+TEST(BadInput, OptionsThatDoNotApplyAreRefused) {
+  Dir d("apply");
+  const std::string out = " --out " + (d / "x.png");
+  for (const char* bad : {"--level 2 --footprint 3", "--renderer traditional --level 2",
+                          "--renderer traditional --footprint 2"}) {
+    const CliResult r = amalgam(kSmall + out + " " + bad);
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
+  }
+  // More threads than cores: no oneTBB warning, the same bytes.
+  const CliResult many = amalgam(kSmall + out + " --threads 512");
+  EXPECT_EQ(many.status, 0);
+  EXPECT_EQ(many.err, "") << "nothing on stderr with --quiet";
+  const std::string bytes = slurp(d / "x.png");
+  EXPECT_EQ(amalgam(kSmall + out + " --threads 1").status, 0);
+  EXPECT_EQ(slurp(d / "x.png"), bytes);
+}
+
 }  // namespace

@@ -64,7 +64,9 @@ json parse_json(const std::string& text, const std::string& file) {
 }
 
 void JsonReader::fail(const std::string& ptr, const std::string& what) const {
-  throw InputError(file_ + ": " + (ptr.empty() ? std::string("top level") : ptr) + ": " + what);
+  // Keys and values quoted from the file are cut: one readable line, however long the input.
+  throw InputError(file_ + ": " + (ptr.empty() ? std::string("top level") : one_line(ptr, 160)) +
+                   ": " + one_line(what, 300));
 }
 
 std::string JsonReader::escape(const std::string& key) {

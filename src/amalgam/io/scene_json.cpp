@@ -119,6 +119,9 @@ class SceneParser {
         }
       }
     }
+    // A camera given with a wrong type is reported before "no geometry": the first problem of
+    // the file in the order a reader meets it.
+    if (auto c = r_.find(root, "camera")) (void)scene_json::read_camera(r_, *c);
     if (out_.prims.empty() && out_.instances.empty())
       r_.fail("",
               "the scene has no geometry (give meshes, spheres, boxes, triangles or "
@@ -419,6 +422,19 @@ class SceneParser {
   std::vector<Bbox> object_bounds_;  ///< per instanced mesh
 };
 
+/// The offset of the first byte that is not part of well-formed UTF-8 (or a NUL), or npos.
+std::size_t first_invalid_utf8(const std::string& s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    int n = c < 0x80 ? 0 : (c >> 5) == 0x6 ? 1 : (c >> 4) == 0xe ? 2 : (c >> 3) == 0x1e ? 3 : -1;
+    if (c == 0 || n < 0 || i + static_cast<std::size_t>(n) >= s.size()) return i;
+    for (int k = 1; k <= n; ++k)
+      if ((static_cast<unsigned char>(s[i + static_cast<std::size_t>(k)]) >> 6) != 0x2) return i;
+    i += static_cast<std::size_t>(n) + 1;
+  }
+  return std::string::npos;
+}
+
 }  // namespace
 
 SceneDescription parse_scene_json(const std::string& text, const std::string& path,
@@ -432,8 +448,14 @@ SceneDescription read_scene_json(const std::string& path, const SceneFileConfig&
   if (!fs::is_regular_file(path, ec)) throw InputError(path + ": no such file");
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
+  in.peek();
+  if (in && in.eof()) throw InputError(path + ": empty file (a scene file is a JSON object)");
   if (!in || !(text << in.rdbuf())) throw InputError(path + ": cannot read the file");
-  return parse_scene_json(text.str(), path, config);
+  const std::string bytes = text.str();
+  if (const std::size_t bad = first_invalid_utf8(bytes); bad != std::string::npos)
+    throw InputError(path + ": not UTF-8 text (byte " + std::to_string(bad) +
+                     "): a scene file is JSON");
+  return parse_scene_json(bytes, path, config);
 }
 
 }  // namespace amalgam

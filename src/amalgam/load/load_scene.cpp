@@ -59,7 +59,10 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
 
 LoadedScene load_scene(const std::string& spec, const Params& params) {
   if (spec.rfind("builtin:", 0) == 0) return load_builtin(spec, params);
-  if (!std::filesystem::exists(spec)) throw InputError(spec + ": no such file");
+  std::error_code ec;
+  const bool exists = std::filesystem::exists(spec, ec);
+  if (ec) throw InputError(spec + ": " + ec.message());  // e.g. a symbolic link loop
+  if (!exists) throw InputError(spec + ": no such file");
   params.check_all_used();       // --set configures builtin scenes only
   return load_scene_path(spec);  // .json scene file or mesh; times its own load and build
 }
