@@ -53,9 +53,13 @@ RenderOutput render(const LoadedScene& scene, const RenderOptions& o, FilmState*
       st.spp_done > o.spp)
     throw InputError("resume: the saved render does not match these options");
 
+#if defined(AMALGAM_BUILD_AVX2_COPY)
   const bool interrupted = active_simd() == Simd::kAvx2
                                ? detail::render_passes_avx2(scene, o, st, control)
                                : detail::render_passes_portable(scene, o, st, control);
+#else  // no AVX2 copy in this build (not GCC, or not x86-64): active_simd() is kPortable
+  const bool interrupted = detail::render_passes_portable(scene, o, st, control);
+#endif
   RenderOutput out = finish(st);
   out.interrupted = interrupted;
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -65,9 +69,11 @@ RenderOutput render(const LoadedScene& scene, const RenderOptions& o, FilmState*
 TraceOutput trace(const LoadedScene& scene, const RenderOptions& o, const Ray& ray) {
   check_options(scene, o);
   TraceOutput out;
+#if defined(AMALGAM_BUILD_AVX2_COPY)
   if (active_simd() == Simd::kAvx2)
     detail::trace_avx2(scene, o, ray, out);
   else
+#endif
     detail::trace_portable(scene, o, ray, out);
   out.per_primary.add(out.counters.total());
   return out;
