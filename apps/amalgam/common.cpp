@@ -64,6 +64,8 @@ Params CommonOptions::params() const {
 
 namespace {
 
+std::string g_activity = "starting";
+
 /// An integer in [lo, hi] written in plain decimal digits (no sign unless lo < 0, no exponent).
 CLI::Validator int_in(long long lo, long long hi, const std::string& what) {
   return CLI::Validator(
@@ -78,6 +80,13 @@ CLI::Validator int_in(long long lo, long long hi, const std::string& what) {
 }
 
 }  // namespace
+
+void set_activity(std::string what) {
+  g_activity.reserve(256);  // later updates rarely need memory, even when it has run out
+  g_activity = std::move(what);
+}
+
+const std::string& activity() { return g_activity; }
 
 const CLI::Validator& positive_int() {
   static const CLI::Validator v = int_in(1, 2147483647, "an integer >= 1");

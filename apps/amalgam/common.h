@@ -46,6 +46,11 @@ std::uint64_t parse_seed(const std::string& text);
 /// followed by B or iB, any case). Throws InputError naming `option` for anything else.
 std::uint64_t parse_bytes(const std::string& text, const std::string& option);
 
+/// What the command is doing, for the one line an out-of-memory failure prints ("reading
+/// scene.json", "rendering", ...). Set by the subcommands as they go.
+void set_activity(std::string what);
+const std::string& activity();
+
 /// Parses "x,y,z" into three floats; throws InputError naming the option.
 Vec3 parse_vec3(const std::string& text, const std::string& option);
 

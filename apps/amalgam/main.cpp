@@ -2,13 +2,38 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <new>
 #include <iostream>
 
 #include "amalgam/util/error.h"
 #include "common.h"
 
+namespace {
+
+/// Out of memory where no handler can catch it (e.g. std::bad_alloc thrown while another
+/// exception unwinds, inside a library): one line naming what was being done, exit 1, no core
+/// dump. Anything else that reaches std::terminate is a bug: abort as usual.
+[[noreturn]] void on_terminate() {
+  if (const std::exception_ptr e = std::current_exception()) {
+    try {
+      std::rethrow_exception(e);
+    } catch (const std::bad_alloc&) {
+      const std::string& what = amalgam::cli::activity();
+      std::fprintf(stderr, "amalgam: out of memory while %s\n", what.c_str());
+      std::_Exit(1);
+    } catch (...) {
+    }
+  }
+  std::abort();
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace amalgam;
+  std::set_terminate(on_terminate);
   CLI::App app{"amalgam: a ray tracer with renderable bounding volumes (amalgams), after "
                "Thompson & Fussell, 'Time Costs of Ray Tracing with Amalgams' (1991)"};
   app.require_subcommand(1);
@@ -96,6 +121,9 @@ int main(int argc, char** argv) {
     if (experiment->parsed()) return cli::run_experiment(exp_name, exp_out, exp_quick, exp_threads);
     if (compare->parsed()) return cli::run_compare(cmp);
     return cli::run_scenes();
+  } catch (const std::bad_alloc&) {
+    std::cerr << "amalgam: out of memory while " << cli::activity() << "\n";
+    return 1;
   } catch (const std::exception& e) {  // the one place failures become exit statuses
     std::cerr << "amalgam: " << e.what() << "\n";
     return exit_status(e);

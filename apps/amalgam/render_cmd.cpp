@@ -183,6 +183,7 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
     throw InputError("--width " + std::to_string(o.width) + " --height " +
                      std::to_string(o.height) + ": the film needs " + human_bytes(film) +
                      ", more than --max-memory " + human_bytes(limit));
+  set_activity("loading and building " + common.scene);
   const LoadedScene scene = load_scene(common.scene, common.params());
   check_options(scene, o);
   if (film + scene_bytes(scene) > limit)
@@ -219,7 +220,9 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
       last_checkpoint = now;
     }
   };
+  set_activity("rendering " + common.scene);
   RenderOutput r = render(scene, o, &state, control);
+  set_activity("writing the outputs of " + common.scene);
   // The work is done: writing its results wins over further signals (on_signal).
   g_finishing.store(true);
 
@@ -269,6 +272,7 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
 
 int run_trace(CommonOptions& common, const std::string& origin, const std::string& direction) {
   common.finish();
+  set_activity("loading and building " + common.scene);
   const LoadedScene scene = load_scene(common.scene, common.params());
   check_options(scene, common.options);
   Ray ray = scene.env.camera.centre_ray(common.options.width, common.options.height);

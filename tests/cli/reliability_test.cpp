@@ -200,4 +200,28 @@ TEST(BadInput, OptionsThatDoNotApplyAreRefused) {
   EXPECT_EQ(slurp(d / "x.png"), bytes);
 }
 
+#if !defined(__SANITIZE_ADDRESS__)  // ASan reserves terabytes of address space: no ulimit -v
+TEST(OutOfMemory, OneLineNamingTheWorkExitOneNoCoreDump) {
+  Dir d("oom");
+  {
+    std::ofstream f(d / "big.json");
+    f << R"({"triangles": [)";
+    for (int i = 0; i < 200000; ++i)
+      f << (i ? "," : "") << "{\"vertices\": [[" << i << ",0,0],[" << i + 1 << ",0,0],[" << i
+        << ",1,0]]}";
+    f << "]}";
+  }
+  // 150 MB of address space: enough to start, not to read and build 200 000 triangles.
+  const std::string cmd = "ulimit -v 150000; " + std::string(AMALGAM_BINARY) + " render " +
+                          (d / "big.json") + " --out " + (d / "x.png") +
+                          " --width 16 --height 16 --spp 1 --quiet 2>" + (d / "err.txt");
+  const int st = std::system(("sh -c '" + cmd + "'").c_str());
+  ASSERT_TRUE(WIFEXITED(st)) << "ended by a signal (a crash or an abort)";
+  EXPECT_EQ(WEXITSTATUS(st), 1);
+  const std::string err = slurp(d / "err.txt");
+  EXPECT_EQ(err, "amalgam: out of memory while loading and building " + (d / "big.json") + "\n");
+  EXPECT_FALSE(fs::exists(d / "x.png"));
+}
+#endif
+
 }  // namespace
