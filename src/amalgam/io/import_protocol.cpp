@@ -1,9 +1,8 @@
 #include "amalgam/io/import_protocol.h"
 
-#include <unistd.h>
-
-#include <cerrno>
 #include <type_traits>
+
+#include "amalgam/util/fd_io.h"
 
 namespace amalgam::import_protocol {
 namespace {
@@ -18,28 +17,6 @@ std::string hello() {
 }
 
 constexpr std::uint64_t kMaxString = std::uint64_t{1} << 24;
-
-bool write_all(int fd, const void* data, std::size_t n) {
-  const char* p = static_cast<const char*>(data);
-  while (n > 0) {
-    const ssize_t w = ::write(fd, p, n);
-    if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) return false;
-    p += w, n -= static_cast<std::size_t>(w);
-  }
-  return true;
-}
-
-bool read_all(int fd, void* data, std::size_t n) {
-  char* p = static_cast<char*>(data);
-  while (n > 0) {
-    const ssize_t r = ::read(fd, p, n);
-    if (r < 0 && errno == EINTR) continue;
-    if (r <= 0) return false;
-    p += r, n -= static_cast<std::size_t>(r);
-  }
-  return true;
-}
 
 bool send_string(int fd, const std::string& s) {
   const std::uint64_t n = s.size();

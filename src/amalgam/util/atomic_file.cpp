@@ -1,5 +1,7 @@
 #include "amalgam/util/atomic_file.h"
 
+#include "amalgam/util/fd_io.h"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -30,15 +32,6 @@ std::atomic<unsigned long> g_counter{0};  ///< tells apart the temporaries of on
 char g_temp_path[PATH_MAX];
 std::atomic<int> g_temp_active{0};
 
-bool write_fd(int fd, const char* p, std::size_t n) {
-  while (n > 0) {
-    const ssize_t w = ::write(fd, p, n);
-    if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) return false;
-    p += w, n -= static_cast<std::size_t>(w);
-  }
-  return true;
-}
 
 /// Makes a completed rename durable (best effort: a directory that cannot be opened or synced
 /// does not fail a write whose data is already safely on disk).
@@ -153,12 +146,12 @@ void AtomicFile::commit() {
     std::fclose(fp);  // memory_ and memory_size_ now hold the contents
     if (target_.kind == OutputTarget::Kind::kStdout) {
       std::fflush(stdout);
-      if (!write_fd(1, memory_, memory_size_))
+      if (!write_all(1, memory_, memory_size_))
         throw RuntimeError("write to standard output failed: " + errno_text(errno));
     } else {
       const int fd = ::open(target_.path.c_str(), O_WRONLY | O_CLOEXEC);
       if (fd < 0) throw RuntimeError("cannot open for writing: " + errno_text(errno));
-      const bool ok = write_fd(fd, memory_, memory_size_);
+      const bool ok = write_all(fd, memory_, memory_size_);
       const int err = errno;
       ::close(fd);
       if (!ok) throw RuntimeError("write failed: " + errno_text(err));
