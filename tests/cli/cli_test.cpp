@@ -41,10 +41,18 @@ CliRun run(const std::string& args, const std::string& err_file = "/dev/null") {
   return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
 }
 
+/// This process's scratch directory, removed when the process ends.
 fs::path temp_dir() {
-  const fs::path d = fs::temp_directory_path() / ("amalgam-cli-" + std::to_string(getpid()));
-  fs::create_directories(d);
-  return d;
+  struct Scratch {
+    fs::path dir = fs::temp_directory_path() / ("amalgam-cli-" + std::to_string(getpid()));
+    ~Scratch() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  };
+  static const Scratch scratch;
+  fs::create_directories(scratch.dir);
+  return scratch.dir;
 }
 
 TEST(Cli, TraceLineTraditionalIsTheWorstCase) {

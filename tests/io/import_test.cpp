@@ -32,9 +32,23 @@ const fs::path kModels = "/usr/share/assimp/models";
       << kModels << " is missing: install Debian's assimp-testmodels package "      \
                     "(apt-get install assimp-testmodels)"
 
-/// A fresh directory for one test's files.
+/// The directories of temp_dir, removed when the test process ends.
+struct TempDirs {
+  std::vector<fs::path> dirs;
+  ~TempDirs() {
+    std::error_code ec;
+    for (const fs::path& d : dirs) fs::remove_all(d, ec);
+  }
+};
+TempDirs g_temp_dirs;
+
+/// A fresh directory for one test's files. Named by the process too: ctest runs tests in
+/// parallel processes, and two of them (both ImportCli tests use "cli_log") must not remove
+/// each other's files.
 fs::path temp_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("amalgam_import_test_" + name);
+  const fs::path d =
+      fs::temp_directory_path() / ("amalgam_import_test_" + name + "_" + std::to_string(getpid()));
+  g_temp_dirs.dirs.push_back(d);
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
