@@ -324,17 +324,29 @@ TEST(ExperimentCli, OutWritesCsvPlotAndReportForEveryExperiment) {
   fs::remove_all(d);
 }
 
-TEST(ExperimentCli, UnknownNameIsBadInputAndWritesNothing) {
-  const fs::path d = fs::temp_directory_path() / ("amalgam_experiment_bad_" + std::to_string(getpid()));
+// One NAME writes that experiment's files and its report only; an unknown NAME is bad input
+// (exit 2, one line listing the names) and writes nothing.
+TEST(ExperimentCli, OneNameWritesOnlyItsFilesAndAnUnknownNameIsBadInput) {
+  const fs::path d = fs::temp_directory_path() / ("amalgam_experiment_one_" + std::to_string(getpid()));
   fs::remove_all(d);
+  const std::string bin = AMALGAM_BINARY;
+  int st = std::system((bin + " experiment lights --quick --out " + d.string() + " >/dev/null 2>&1").c_str());
+  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0);
+  std::set<std::string> files;
+  for (const auto& e : fs::directory_iterator(d)) files.insert(e.path().filename().string());
+  EXPECT_EQ(files, (std::set<std::string>{"lights.csv", "lights.gp", "lights.png", "report.md"}));
+  const std::string report = slurp(d / "report.md");
+  EXPECT_NE(report.find("\n## lights: "), std::string::npos);
+  EXPECT_EQ(report.find("\n## noise: "), std::string::npos) << "only the experiment asked for";
+  fs::remove_all(d);
+
   const fs::path err = d.string() + ".err";
-  const std::string cmd = std::string(AMALGAM_BINARY) + " experiment no-such --quick --out " +
-                          d.string() + " 2>" + err.string();
-  const int st = std::system(cmd.c_str());
+  st = std::system((bin + " experiment no-such --quick --out " + d.string() + " 2>" + err.string()).c_str());
   EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 2);
   const std::string e = slurp(err);
   EXPECT_NE(e.find("no-such"), std::string::npos) << e;
   EXPECT_NE(e.find("lights"), std::string::npos) << "the message lists the names: " << e;
+  EXPECT_EQ(std::count(e.begin(), e.end(), '\n'), 1) << e;
   EXPECT_FALSE(fs::exists(d / "report.md"));
   fs::remove(err);
   fs::remove_all(d);
