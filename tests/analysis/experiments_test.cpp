@@ -179,8 +179,10 @@ TEST(Experiments, NoiseFollowsOneOverSpp) {
     const std::size_t a = rows.at(1), b = rows.at(4);
     const double v1 = r.table.at(a, "pixel_variance"), v4 = r.table.at(b, "pixel_variance");
     ASSERT_GT(v4, 0.0) << "config " << config;
-    EXPECT_GT(v1 / v4, 2.5) << "config " << config << ": variance at spp 1 " << v1 << ", at 4 " << v4;
-    EXPECT_LT(v1 / v4, 6.4) << "config " << config << ": variance at spp 1 " << v1 << ", at 4 " << v4;
+    EXPECT_GT(v1 / v4, 2.5) << "config " << config << ": variance at spp 1 " << v1 << ", at 4 "
+                            << v4;
+    EXPECT_LT(v1 / v4, 6.4) << "config " << config << ": variance at spp 1 " << v1 << ", at 4 "
+                            << v4;
     EXPECT_NEAR(r.table.at(b, "tests_per_sample"), r.table.at(a, "tests_per_sample"),
                 0.05 * r.table.at(a, "tests_per_sample"))
         << "config " << config;
@@ -255,11 +257,13 @@ std::vector<std::vector<double>> read_csv(const fs::path& p, std::vector<std::st
 // DIR/report.md, with a summary table of verdicts; it leaves no temporary files and prints one
 // line per experiment. lights.csv holds the exact figures of the closed forms.
 TEST(ExperimentCli, OutWritesCsvPlotAndReportForEveryExperiment) {
-  const fs::path d = fs::temp_directory_path() / ("amalgam_experiment_cli_" + std::to_string(getpid()));
+  const fs::path d =
+      fs::temp_directory_path() / ("amalgam_experiment_cli_" + std::to_string(getpid()));
   fs::remove_all(d);
   const fs::path out_txt = d.string() + ".stdout";
-  const std::string cmd = std::string(AMALGAM_BINARY) + " experiment all --quick --threads 2 --out " +
-                          d.string() + " >" + out_txt.string() + " 2>/dev/null";
+  const std::string cmd = std::string(AMALGAM_BINARY) +
+                          " experiment all --quick --threads 2 --out " + d.string() + " >" +
+                          out_txt.string() + " 2>/dev/null";
   const int st = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << cmd;
   const std::string stdout_text = slurp(out_txt);
@@ -327,10 +331,12 @@ TEST(ExperimentCli, OutWritesCsvPlotAndReportForEveryExperiment) {
 // One NAME writes that experiment's files and its report only; an unknown NAME is bad input
 // (exit 2, one line listing the names) and writes nothing.
 TEST(ExperimentCli, OneNameWritesOnlyItsFilesAndAnUnknownNameIsBadInput) {
-  const fs::path d = fs::temp_directory_path() / ("amalgam_experiment_one_" + std::to_string(getpid()));
+  const fs::path d =
+      fs::temp_directory_path() / ("amalgam_experiment_one_" + std::to_string(getpid()));
   fs::remove_all(d);
   const std::string bin = AMALGAM_BINARY;
-  int st = std::system((bin + " experiment lights --quick --out " + d.string() + " >/dev/null 2>&1").c_str());
+  int st = std::system(
+      (bin + " experiment lights --quick --out " + d.string() + " >/dev/null 2>&1").c_str());
   EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0);
   std::set<std::string> files;
   for (const auto& e : fs::directory_iterator(d)) files.insert(e.path().filename().string());
@@ -341,7 +347,8 @@ TEST(ExperimentCli, OneNameWritesOnlyItsFilesAndAnUnknownNameIsBadInput) {
   fs::remove_all(d);
 
   const fs::path err = d.string() + ".err";
-  st = std::system((bin + " experiment no-such --quick --out " + d.string() + " 2>" + err.string()).c_str());
+  st = std::system(
+      (bin + " experiment no-such --quick --out " + d.string() + " 2>" + err.string()).c_str());
   EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 2);
   const std::string e = slurp(err);
   EXPECT_NE(e.find("no-such"), std::string::npos) << e;

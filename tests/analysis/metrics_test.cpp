@@ -8,12 +8,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "amalgam/io/image.h"
 
@@ -223,13 +222,14 @@ TEST_F(CompareCli, JsonAndErrorImage) {
   ASSERT_EQ(ew, w);
   ASSERT_EQ(eh, h);
   const auto srgb8 = [](float v) {
-    return static_cast<int>(std::lround(255 * (v <= 0.0031308f ? 12.92 * v
-                                                               : 1.055 * std::pow(v, 1 / 2.4) - 0.055)));
+    return static_cast<int>(
+        std::lround(255 * (v <= 0.0031308f ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055)));
   };
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const Vec3 c = err[static_cast<std::size_t>(y) * w + x];
-      const int want[3] = {x < w / 2 ? 0xfd : 0x44, x < w / 2 ? 0xe7 : 0x01, x < w / 2 ? 0x25 : 0x54};
+      const int want[3] = {x < w / 2 ? 0xfd : 0x44, x < w / 2 ? 0xe7 : 0x01,
+                           x < w / 2 ? 0x25 : 0x54};
       for (int ch = 0; ch < 3; ++ch)
         EXPECT_NEAR(srgb8(c[ch]), want[ch], 1) << "pixel " << x << "," << y << " channel " << ch;
     }

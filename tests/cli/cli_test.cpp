@@ -117,10 +117,10 @@ TEST(Cli, CostImageCountsAddUpToTheStatsAndPngIsViridisOnALogScale) {
                 (d / "c.pfm").string() + " --stats " + (d / "s.json").string())
                 .status,
             0);
-  ASSERT_EQ(run(common + "--out " + (d / "b.pfm").string() + " --cost-image " +
-                (d / "c.png").string())
-                .status,
-            0);
+  ASSERT_EQ(
+      run(common + "--out " + (d / "b.pfm").string() + " --cost-image " + (d / "c.png").string())
+          .status,
+      0);
   std::ifstream in(d / "s.json");
   const auto j = nlohmann::json::parse(in);
   int w = 0, h = 0;
@@ -138,7 +138,8 @@ TEST(Cli, CostImageCountsAddUpToTheStatsAndPngIsViridisOnALogScale) {
     counts.push_back(v.x);
     sum += tests, lo = std::min<double>(lo, v.x), hi = std::max<double>(hi, v.x);
   }
-  EXPECT_EQ(sum, j["tests"]["total"].get<double>()) << "the cost image's pixels add up to the total";
+  EXPECT_EQ(sum, j["tests"]["total"].get<double>())
+      << "the cost image's pixels add up to the total";
   EXPECT_LT(lo, hi) << "the cost varies over the image";
   EXPECT_NEAR(j["per_primary_ray"]["mean"].get<double>() * 40 * 30 * 2, sum, 1e-6 * sum);
 

@@ -53,9 +53,9 @@ double line_hit_fraction(const Bbox& box, const std::vector<Square>& squares, in
   const double cx = 0.5 * (box.lo.x + box.hi.x), cy = 0.5 * (box.lo.y + box.hi.y),
                cz = 0.5 * (box.lo.z + box.hi.z);
   const double c[3] = {cx, cy, cz};
-  const double radius = 0.5 * std::sqrt(std::pow(box.hi.x - box.lo.x, 2) +
-                                        std::pow(box.hi.y - box.lo.y, 2) +
-                                        std::pow(box.hi.z - box.lo.z, 2));
+  const double radius =
+      0.5 * std::sqrt(std::pow(box.hi.x - box.lo.x, 2) + std::pow(box.hi.y - box.lo.y, 2) +
+                      std::pow(box.hi.z - box.lo.z, 2));
   int met = 0, hit = 0;
   while (met < lines) {
     // Direction uniform on the sphere; an orthonormal frame across it.
@@ -63,7 +63,8 @@ double line_hit_fraction(const Bbox& box, const std::vector<Square>& squares, in
     const double r = std::sqrt(std::max(0.0, 1 - z * z));
     const double d[3] = {r * std::cos(phi), r * std::sin(phi), z};
     const double a[3] = {std::fabs(d[0]) < 0.9 ? 1.0 : 0.0, std::fabs(d[0]) < 0.9 ? 0.0 : 1.0, 0};
-    double e1[3] = {a[1] * d[2] - a[2] * d[1], a[2] * d[0] - a[0] * d[2], a[0] * d[1] - a[1] * d[0]};
+    double e1[3] = {a[1] * d[2] - a[2] * d[1], a[2] * d[0] - a[0] * d[2],
+                    a[0] * d[1] - a[1] * d[0]};
     const double n1 = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
     for (double& v : e1) v /= n1;
     const double e2[3] = {d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2],
@@ -170,12 +171,11 @@ TEST(BakeOpacity, CombinedAndExactBakesOfTwoParallelSquaresMeetTheMonteCarlo) {
 TEST(BakeOpacity, ThreeOrthogonalSquaresMeetTheMonteCarlo) {
   std::vector<Primitive> prims;
   for (int axis = 0; axis < 3; ++axis) add_square(prims, axis, 0.0f);
-  const double truth = line_hit_fraction({{-1, -1, -1}, {1, 1, 1}},
-                                         {{0, 0, 1}, {1, 0, 1}, {2, 0, 1}}, 200000, 4);
+  const double truth =
+      line_hit_fraction({{-1, -1, -1}, {1, 1, 1}}, {{0, 0, 1}, {1, 0, 1}, {2, 0, 1}}, 200000, 4);
   const int rays = 4096;
   const ExplicitHierarchy e = build_explicit(prims, {Surface{}}, exact_bake(rays));
-  EXPECT_NEAR(e.appearances[0].opacity, truth,
-              tolerance(truth, rays, tolerance(truth, 200000)));
+  EXPECT_NEAR(e.appearances[0].opacity, truth, tolerance(truth, rays, tolerance(truth, 200000)));
   BuildConfig combined;
   combined.bake.rays = rays;
   const ExplicitHierarchy c = build_explicit(prims, {Surface{}}, combined);

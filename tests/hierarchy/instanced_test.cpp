@@ -1,8 +1,6 @@
 // The two-level instanced hierarchy against the same scene expanded into one explicit
 // hierarchy, and the scene file producing it.
 
-#include "amalgam/traverse/traverse.h"
-#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/hierarchy/instanced.h"
 
 #include <gtest/gtest.h>
@@ -12,9 +10,11 @@
 #include <fstream>
 #include <numbers>
 
+#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/math/random.h"
 #include "amalgam/render/render.h"
+#include "amalgam/traverse/traverse.h"
 
 namespace amalgam {
 namespace {

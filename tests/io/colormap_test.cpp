@@ -44,8 +44,11 @@ int srgb_code(float v) {
 // #440154, #3b528b, #21918c, #5ec962, #fde725. On a linear scale t = v / max; on the log
 // scale t = log1p(v) / log1p(max), so v = e^(4t) - 1 with max e^4 - 1 hits the same five.
 TEST(Colormap, FalseColourIsPublishedViridisOnTheStatedScale) {
-  const int hex[5][3] = {{0x44, 0x01, 0x54}, {0x3b, 0x52, 0x8b}, {0x21, 0x91, 0x8c},
-                         {0x5e, 0xc9, 0x62}, {0xfd, 0xe7, 0x25}};
+  const int hex[5][3] = {{0x44, 0x01, 0x54},
+                         {0x3b, 0x52, 0x8b},
+                         {0x21, 0x91, 0x8c},
+                         {0x5e, 0xc9, 0x62},
+                         {0xfd, 0xe7, 0x25}};
   const std::vector<double> linear = {0, 1, 2, 3, 4};
   std::vector<double> log_spaced;
   for (int k = 0; k <= 4; ++k) log_spaced.push_back(std::expm1(k));

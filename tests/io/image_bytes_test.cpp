@@ -35,7 +35,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path temp_file(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("amalgam_image_bytes_" + std::to_string(getpid()));
+  const fs::path d =
+      fs::temp_directory_path() / ("amalgam_image_bytes_" + std::to_string(getpid()));
   fs::create_directories(d);
   return d / name;
 }
@@ -53,7 +54,8 @@ std::string read_bytes(const fs::path& path) {
 }
 
 std::uint32_t be32(const std::string& s, std::size_t at) {
-  return (std::uint32_t(std::uint8_t(s[at])) << 24) | (std::uint32_t(std::uint8_t(s[at + 1])) << 16) |
+  return (std::uint32_t(std::uint8_t(s[at])) << 24) |
+         (std::uint32_t(std::uint8_t(s[at + 1])) << 16) |
          (std::uint32_t(std::uint8_t(s[at + 2])) << 8) | std::uint32_t(std::uint8_t(s[at + 3]));
 }
 
@@ -96,9 +98,9 @@ DecodedPng decode_png(const std::string& file) {
   const std::size_t stride = std::size_t(out.width) * 3;
   std::vector<std::uint8_t> raw((stride + 1) * out.height);
   uLongf raw_len = raw.size();
-  EXPECT_EQ(uncompress(raw.data(), &raw_len, reinterpret_cast<const Bytef*>(idat.data()),
-                       idat.size()),
-            Z_OK);
+  EXPECT_EQ(
+      uncompress(raw.data(), &raw_len, reinterpret_cast<const Bytef*>(idat.data()), idat.size()),
+      Z_OK);
   EXPECT_EQ(raw_len, raw.size());
   out.rgb.assign(stride * out.height, 0);
   for (int y = 0; y < out.height; ++y) {
@@ -110,16 +112,25 @@ DecodedPng decode_png(const std::string& file) {
       const int a = i >= 3 ? row[i - 3] : 0, b = up ? up[i] : 0, c = (up && i >= 3) ? up[i - 3] : 0;
       int pred = 0;
       switch (filter) {
-        case 0: pred = 0; break;
-        case 1: pred = a; break;
-        case 2: pred = b; break;
-        case 3: pred = (a + b) / 2; break;
+        case 0:
+          pred = 0;
+          break;
+        case 1:
+          pred = a;
+          break;
+        case 2:
+          pred = b;
+          break;
+        case 3:
+          pred = (a + b) / 2;
+          break;
         case 4: {
           const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b), pc = std::abs(p - c);
           pred = (pa <= pb && pa <= pc) ? a : (pb <= pc ? b : c);
           break;
         }
-        default: ADD_FAILURE() << "unknown filter " << int(filter);
+        default:
+          ADD_FAILURE() << "unknown filter " << int(filter);
       }
       row[i] = std::uint8_t(in[i] + pred);
     }
@@ -145,7 +156,8 @@ std::string encode_png(int w, int h, int channels, const std::vector<std::uint8_
   }
   std::vector<Bytef> z(compressBound(raw.size()));
   uLongf zlen = z.size();
-  EXPECT_EQ(compress(z.data(), &zlen, reinterpret_cast<const Bytef*>(raw.data()), raw.size()), Z_OK);
+  EXPECT_EQ(compress(z.data(), &zlen, reinterpret_cast<const Bytef*>(raw.data()), raw.size()),
+            Z_OK);
   std::string ihdr;
   for (std::uint32_t v : {std::uint32_t(w), std::uint32_t(h)})
     for (int s = 24; s >= 0; s -= 8) ihdr.push_back(char((v >> s) & 0xff));
@@ -167,7 +179,7 @@ struct Encoded {
   float linear;
   int code;
 };
-constexpr Encoded kEncoded[] = {{0.0f, 0}, {0.002f, 7}, {0.05f, 63}, {0.18f, 118},
+constexpr Encoded kEncoded[] = {{0.0f, 0},   {0.002f, 7}, {0.05f, 63}, {0.18f, 118},
                                 {0.5f, 188}, {1.0f, 255}, {2.5f, 255}};
 
 TEST(ImageBytes, PngWriterStoresSrgbCodesComputedByHand) {
@@ -201,8 +213,8 @@ TEST(ImageBytes, PngReaderDecodesSrgbCodesToLinearComputedByHand) {
     int code;
     double linear;
   };
-  const Decoded known[] = {{0, 0.0}, {10, 0.0030353}, {64, 0.0512695}, {128, 0.2158605},
-                           {188, 0.5028865}, {255, 1.0}};
+  const Decoded known[] = {{0, 0.0},         {10, 0.0030353},  {64, 0.0512695},
+                           {128, 0.2158605}, {188, 0.5028865}, {255, 1.0}};
   const int n = int(std::size(known));
   // RGB: one pixel per known code in red, green 0, blue code 10.
   std::vector<std::uint8_t> rgb;
@@ -234,8 +246,9 @@ TEST(ImageBytes, PngReaderDecodesSrgbCodesToLinearComputedByHand) {
 // chosen exactly representable as half, so they must come back bit-exact.
 TEST(ImageBytes, ExrHoldsHalfChannelsRGBTopRowFirst) {
   const int w = 3, h = 2;
-  const std::vector<Vec3> px = {{0.5f, 2.0f, 1000.5f}, {0.0f, -3.0f, 0.125f}, {1.0f, 0.25f, 4.0f},
-                                {8.0f, 0.75f, 0.0f},   {65504.0f, 1.5f, 3.0f}, {0.0625f, 5.0f, 7.0f}};
+  const std::vector<Vec3> px = {{0.5f, 2.0f, 1000.5f},  {0.0f, -3.0f, 0.125f},
+                                {1.0f, 0.25f, 4.0f},    {8.0f, 0.75f, 0.0f},
+                                {65504.0f, 1.5f, 3.0f}, {0.0625f, 5.0f, 7.0f}};
   const fs::path path = temp_file("known.exr");
   write_image(path.string(), w, h, px);
   Imf::InputFile in(path.c_str());

@@ -27,10 +27,11 @@ const fs::path kModels = "/usr/share/assimp/models";
 
 // The models come with Debian's assimp-testmodels, which scripts/deps.sh installs: missing is
 // a failure, not a skip (a skipped test guards nothing).
-#define REQUIRE_MODELS()                                                            \
-  ASSERT_TRUE(fs::is_directory(kModels))                                            \
-      << kModels << " is missing: install Debian's assimp-testmodels package "      \
-                    "(apt-get install assimp-testmodels)"
+#define REQUIRE_MODELS()                                            \
+  ASSERT_TRUE(fs::is_directory(kModels))                            \
+      << kModels                                                    \
+      << " is missing: install Debian's assimp-testmodels package " \
+         "(apt-get install assimp-testmodels)"
 
 /// The directories of temp_dir, removed when the test process ends.
 struct TempDirs {

@@ -67,8 +67,10 @@ double total_area(const SceneDescription& s) {
 
 void expect_box(const Bbox& b, Vec3 lo, Vec3 hi, const char* what) {
   for (int k = 0; k < 3; ++k) {
-    EXPECT_NEAR(b.lo[k], lo[k], 1e-5) << what << ": lo." << "xyz"[k];
-    EXPECT_NEAR(b.hi[k], hi[k], 1e-5) << what << ": hi." << "xyz"[k];
+    EXPECT_NEAR(b.lo[k], lo[k], 1e-5) << what << ": lo."
+                                      << "xyz"[k];
+    EXPECT_NEAR(b.hi[k], hi[k], 1e-5) << what << ": hi."
+                                      << "xyz"[k];
   }
 }
 
@@ -84,8 +86,8 @@ TEST_F(SceneKeys, PlainMeshKeepsItsCoordinates) {
 TEST_F(SceneKeys, FitScalesToTheLargestExtentRestingOnYZero) {
   expect_box(bounds_of(scene(R"("fit": 2)")), {-1, 0, -0.25f}, {1, 1, 0.25f}, "fit 2");
   expect_box(bounds_of(scene(R"("fit": 10)")), {-5, 0, -1.25f}, {5, 5, 1.25f}, "fit 10");
-  expect_box(bounds_of(scene(R"("fit": 2, "transform": {"translate": [0, 0, 5]})")),
-             {-1, 0, 4.75f}, {1, 1, 5.25f}, "fit, then translate");
+  expect_box(bounds_of(scene(R"("fit": 2, "transform": {"translate": [0, 0, 5]})")), {-1, 0, 4.75f},
+             {1, 1, 5.25f}, "fit, then translate");
 }
 
 // subdivide: n splits every triangle into 4 at its edge midpoints, n times: 4^n as many
@@ -133,9 +135,9 @@ TEST_F(SceneKeys, RotationsTurnTheMeshRightHanded) {
              {0, 0, 0}, {1, 4, 2}, "rotate_x_deg then rotate_z_deg");
   // Scale 2, rotate about z by 90, translate by 10 in x: [0,8]x[0,4]x[0,2] -> x in [-4, 0],
   // y in [0, 8] -> x in [6, 10].
-  expect_box(bounds_of(scene(
-                 R"("transform": {"scale": 2, "rotate_z_deg": 90, "translate": [10, 0, 0]})")),
-             {6, 0, 0}, {10, 8, 2}, "scale, rotate, translate");
+  expect_box(
+      bounds_of(scene(R"("transform": {"scale": 2, "rotate_z_deg": 90, "translate": [10, 0, 0]})")),
+      {6, 0, 0}, {10, 8, 2}, "scale, rotate, translate");
   // A single triangle's vertex, exactly where the rotation puts it: (4, 0, 0) about y by 90.
   const SceneDescription s = scene(R"("transform": {"rotate_y_deg": 90})");
   bool found = false;

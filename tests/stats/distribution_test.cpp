@@ -63,7 +63,7 @@ TEST(CostDistribution, ValuesAboveTheDenseRangeAreExact) {
   d.add(huge);
   EXPECT_EQ(d.count(), 5u);
   EXPECT_DOUBLE_EQ(d.mean(), (30.0 + double(big + 1) + double(huge)) / 5);
-  EXPECT_EQ(d.quantile(0.5), 10u);   // 3 of 5 values <= 10
+  EXPECT_EQ(d.quantile(0.5), 10u);       // 3 of 5 values <= 10
   EXPECT_EQ(d.quantile(0.61), big + 1);  // needs 4 values
   EXPECT_EQ(d.quantile(0.8), big + 1);
   EXPECT_EQ(d.quantile(0.99), huge);

@@ -9,8 +9,8 @@
 
 #include <string>
 
-#include "amalgam/hierarchy/wide.h"
 #include "amalgam/hierarchy/explicit.h"
+#include "amalgam/hierarchy/wide.h"
 #include "amalgam/traverse/lod.h"
 #include "amalgam/traverse/reference.h"
 #include "amalgam/traverse/traverse.h"
