@@ -233,45 +233,6 @@ std::string only_line(const fs::path& err_file) {
   return line;
 }
 
-// Outputs that cannot be written, for reasons that hold for root too (the suite may run as
-// root, where permission bits stop nothing): a parent that is a regular file (open fails), a
-// destination that is a directory (the rename fails after the temporary was written). Exit 1,
-// one line naming the path, and nothing left behind: no temporary, the old entries untouched.
-TEST(Cli, UnwritableOutputIsARuntimeFailureWithoutPartialFiles) {
-  const fs::path d = temp_dir() / "unwritable";
-  fs::remove_all(d);
-  fs::create_directories(d / "out.png");  // a directory where the image should go
-  std::ofstream(d / "file") << "a regular file";
-  const std::string err = (temp_dir() / "unwritable-err.txt").string();
-  const std::string small = "render builtin:line --width 4 --height 4 --spp 1 --quiet ";
-  struct Case {
-    std::string args, path, reason;
-  };
-  const Case cases[] = {
-      {"--out " + (d / "file" / "x.png").string(), (d / "file" / "x.png").string(),
-       "Not a directory"},
-      {"--out " + (d / "out.png").string(), (d / "out.png").string(), "Is a directory"},
-      {"--out " + (d / "ok.png").string() + " --stats " + (d / "out.png").string(),
-       (d / "out.png").string(), "Is a directory"},
-      {"--out " + (d / "ok.png").string() + " --cost-image " + (d / "out.png").string(),
-       (d / "out.png").string(), "Is a directory"},
-  };
-  for (const Case& c : cases) {
-    SCOPED_TRACE(c.args);
-    EXPECT_EQ(run(small + c.args, err).status, 1);
-    const std::string line = only_line(err);
-    EXPECT_EQ(line.rfind("amalgam: " + c.path + ": ", 0), 0u) << line;
-    EXPECT_NE(line.find(c.reason), std::string::npos) << line;
-    std::vector<std::string> names = entries(d);
-    names.erase(std::remove(names.begin(), names.end(), "ok.png"), names.end());
-    EXPECT_EQ(names, (std::vector<std::string>{"file", "out.png"})) << "a temporary was left";
-    EXPECT_TRUE(fs::is_directory(d / "out.png"));
-    EXPECT_TRUE(fs::is_empty(d / "out.png"));
-    EXPECT_EQ(slurp(d / "file"), "a regular file");
-  }
-  fs::remove_all(d);
-}
-
 // A write that fails half-way (an injected error: the file size limit of `ulimit -f`, which
 // binds root too, with SIGXFSZ ignored so that write(2) returns EFBIG): exit 1, one line, the
 // previous file intact byte for byte, no temporary left; for every image format.
