@@ -211,6 +211,45 @@ TEST(Cli, BadInputExitsTwoWithOneLineAndNoOutput) {
   fs::remove_all(d);
 }
 
+// Meshes are imported by a helper process (AMALGAM_IMPORT_HELPER names it; here a stand-in,
+// tests/io/fake_importer.cpp, that aborts as Assimp 5.2 does on some corrupt files): its crash
+// is bad input, one line, exit 2; a helper that cannot be started is a runtime failure, exit 1.
+TEST(Cli, AnImporterCrashIsOneLineExitTwoAndAMissingImporterExitOne) {
+  const fs::path d = temp_dir();
+  const std::string mesh = (d / "tri.obj").string(), out = (d / "never.png").string(),
+                    err = (d / "err.txt").string();
+  std::ofstream(mesh) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  ::setenv("AMALGAM_IMPORT_HELPER", AMALGAM_FAKE_IMPORTER, 1);
+  const CliRun crash = run("render " + mesh + " --out " + out, err);
+  ::setenv("AMALGAM_IMPORT_HELPER", (d / "no-such-helper").c_str(), 1);
+  const CliRun missing = run("render " + mesh + " --out " + out);
+  ::unsetenv("AMALGAM_IMPORT_HELPER");
+  EXPECT_EQ(crash.status, 2);
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_FALSE(fs::exists(out));
+  std::ifstream in(err);
+  std::string line, rest;
+  std::getline(in, line);
+  EXPECT_EQ(line,
+            "amalgam: " + mesh + ": the importer crashed on this file (signal 6); is it corrupt?");
+  EXPECT_FALSE(std::getline(in, rest)) << "one line only";
+  EXPECT_EQ(run("render " + mesh + " --width 8 --height 8 --spp 1 --quiet --out " + out).status, 0)
+      << "the real helper, found next to amalgam";
+  fs::remove_all(d);
+}
+
+TEST(Cli, HelpForEverySubcommand) {
+  for (const char* sub : {"", "render", "trace", "scenes", "experiment"}) {
+    const CliRun r = run(std::string(sub) + " --help");
+    EXPECT_EQ(r.status, 0) << sub;
+    EXPECT_NE(r.out.find("Usage"), std::string::npos) << sub;
+  }
+  const CliRun s = run("scenes");
+  EXPECT_EQ(s.status, 0);
+  for (const char* name : {"builtin:line", "builtin:prisms", "builtin:poisson", "builtin:demo"})
+    EXPECT_NE(s.out.find(name), std::string::npos) << name;
+}
+
 /// The names in directory `d`, sorted.
 std::vector<std::string> entries(const fs::path& d) {
   std::vector<std::string> names;
@@ -269,45 +308,6 @@ TEST(Cli, AWriteFailingHalfWayLeavesThePreviousFileIntact) {
             0);
   EXPECT_EQ(fs::file_size(out), std::string("PF\n128 128\n-1.0\n").size() + 128u * 128u * 12u);
   fs::remove_all(d);
-}
-
-// Meshes are imported by a helper process (AMALGAM_IMPORT_HELPER names it; here a stand-in,
-// tests/io/fake_importer.cpp, that aborts as Assimp 5.2 does on some corrupt files): its crash
-// is bad input, one line, exit 2; a helper that cannot be started is a runtime failure, exit 1.
-TEST(Cli, AnImporterCrashIsOneLineExitTwoAndAMissingImporterExitOne) {
-  const fs::path d = temp_dir();
-  const std::string mesh = (d / "tri.obj").string(), out = (d / "never.png").string(),
-                    err = (d / "err.txt").string();
-  std::ofstream(mesh) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-  ::setenv("AMALGAM_IMPORT_HELPER", AMALGAM_FAKE_IMPORTER, 1);
-  const CliRun crash = run("render " + mesh + " --out " + out, err);
-  ::setenv("AMALGAM_IMPORT_HELPER", (d / "no-such-helper").c_str(), 1);
-  const CliRun missing = run("render " + mesh + " --out " + out);
-  ::unsetenv("AMALGAM_IMPORT_HELPER");
-  EXPECT_EQ(crash.status, 2);
-  EXPECT_EQ(missing.status, 1);
-  EXPECT_FALSE(fs::exists(out));
-  std::ifstream in(err);
-  std::string line, rest;
-  std::getline(in, line);
-  EXPECT_EQ(line,
-            "amalgam: " + mesh + ": the importer crashed on this file (signal 6); is it corrupt?");
-  EXPECT_FALSE(std::getline(in, rest)) << "one line only";
-  EXPECT_EQ(run("render " + mesh + " --width 8 --height 8 --spp 1 --quiet --out " + out).status, 0)
-      << "the real helper, found next to amalgam";
-  fs::remove_all(d);
-}
-
-TEST(Cli, HelpForEverySubcommand) {
-  for (const char* sub : {"", "render", "trace", "scenes", "experiment"}) {
-    const CliRun r = run(std::string(sub) + " --help");
-    EXPECT_EQ(r.status, 0) << sub;
-    EXPECT_NE(r.out.find("Usage"), std::string::npos) << sub;
-  }
-  const CliRun s = run("scenes");
-  EXPECT_EQ(s.status, 0);
-  for (const char* name : {"builtin:line", "builtin:prisms", "builtin:poisson", "builtin:demo"})
-    EXPECT_NE(s.out.find(name), std::string::npos) << name;
 }
 
 }  // namespace
