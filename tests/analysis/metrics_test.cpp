@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 #include <string>
@@ -187,21 +188,56 @@ TEST_F(CompareCli, IdenticalImagesPrintInf) {
   EXPECT_NE(r.out.find("ssim      1"), std::string::npos) << r.out;
 }
 
+// b = a plus 0.25 in the red channel of the left half of the pixels. Per channel the error is
+// 0.25 on one sixth of all samples: RMSE sqrt(0.0625 / 6), PSNR -20 log10(RMSE), mean
+// |error| 0.25 / 6, max 0.25; per pixel (the error image) sqrt(0.0625 / 3) on the left half,
+// 0 on the right: viridis' top (#fde725) and bottom (#440154) on a linear scale.
 TEST_F(CompareCli, JsonAndErrorImage) {
-  const std::string a = file("a.pfm"), b = file("b.exr"), e = file("err.png");
-  auto img = texture(16, 12);
-  write_image(a, 16, 12, img);
-  for (Vec3& p : img) p.x += 0.25f;
-  write_image(b, 16, 12, img);
+  const int w = 16, h = 12;
+  const std::string a = file("a.pfm"), b = file("b.pfm"), e = file("err.png");
+  const std::vector<Vec3> img = texture(w, h);
+  std::vector<Vec3> shifted = img;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w / 2; ++x) shifted[static_cast<std::size_t>(y) * w + x].x += 0.25f;
+  write_image(a, w, h, img);
+  write_image(b, w, h, shifted);
   const CliRun r = run(a + " " + b + " --json --error-image " + e);
-  EXPECT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.out.find("\"rmse\""), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("\"ssim\""), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("\"psnr_db\""), std::string::npos) << r.out;
-  int w = 0, h = 0;
-  EXPECT_EQ(read_image(e, w, h).size(), 16u * 12u);
-  EXPECT_EQ(w, 16);
-  EXPECT_EQ(h, 12);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const double rmse = std::sqrt(0.0625 / 6);
+  EXPECT_EQ(j["a"], a);
+  EXPECT_EQ(j["b"], b);
+  EXPECT_EQ(j["width"], w);
+  EXPECT_EQ(j["height"], h);
+  EXPECT_NEAR(j["rmse"].get<double>(), rmse, 1e-6);
+  EXPECT_NEAR(j["psnr_db"].get<double>(), -20 * std::log10(rmse), 1e-4);
+  EXPECT_NEAR(j["mean_abs_error"].get<double>(), 0.25 / 6, 1e-6);
+  EXPECT_NEAR(j["max_abs_error"].get<double>(), 0.25, 1e-6);
+  EXPECT_NEAR(j["ssim"].get<double>(), ssim(img, shifted, w, h), 1e-12);
+  EXPECT_LT(j["ssim"].get<double>(), 0.99);
+  EXPECT_EQ(j["error_image"], e);
+  EXPECT_NEAR(j["error_image_max"].get<double>(), std::sqrt(0.0625 / 3), 1e-6);
+  int ew = 0, eh = 0;
+  const std::vector<Vec3> err = read_image(e, ew, eh);
+  ASSERT_EQ(ew, w);
+  ASSERT_EQ(eh, h);
+  const auto srgb8 = [](float v) {
+    return static_cast<int>(
+        std::lround(255 * (v <= 0.0031308f ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055)));
+  };
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const Vec3 c = err[static_cast<std::size_t>(y) * w + x];
+      const int want[3] = {x < w / 2 ? 0xfd : 0x44, x < w / 2 ? 0xe7 : 0x01,
+                           x < w / 2 ? 0x25 : 0x54};
+      for (int ch = 0; ch < 3; ++ch)
+        EXPECT_NEAR(srgb8(c[ch]), want[ch], 1) << "pixel " << x << "," << y << " channel " << ch;
+    }
+  // The text form prints the same figures.
+  const CliRun text = run(a + " " + b);
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("size      16x12"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("max_abs   0.25\n"), std::string::npos) << text.out;
 }
 
 TEST_F(CompareCli, SizeMismatchIsBadInput) {

@@ -3,12 +3,22 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
+#include <tuple>
+#include <vector>
+
+#include "amalgam/io/colormap.h"
+#include "amalgam/io/image.h"
+#include "amalgam/io/srgb.h"
 
 namespace {
 
@@ -31,10 +41,18 @@ CliRun run(const std::string& args, const std::string& err_file = "/dev/null") {
   return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
 }
 
+/// This process's scratch directory, removed when the process ends.
 fs::path temp_dir() {
-  const fs::path d = fs::temp_directory_path() / ("amalgam-cli-" + std::to_string(getpid()));
-  fs::create_directories(d);
-  return d;
+  struct Scratch {
+    fs::path dir = fs::temp_directory_path() / ("amalgam-cli-" + std::to_string(getpid()));
+    ~Scratch() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  };
+  static const Scratch scratch;
+  fs::create_directories(scratch.dir);
+  return scratch.dir;
 }
 
 TEST(Cli, TraceLineTraditionalIsTheWorstCase) {
@@ -56,8 +74,17 @@ TEST(Cli, RenderWritesImageCostImageAndStats) {
           (d / "a.png").string() + " --cost-image " + (d / "c.png").string() + " --stats " +
           (d / "s.json").string());
   ASSERT_EQ(r.status, 0);
-  EXPECT_GT(fs::file_size(d / "a.png"), 100u);
-  EXPECT_GT(fs::file_size(d / "c.png"), 100u);
+  // Both images are real 40 x 30 pictures, not just files: the render shows the prisms against
+  // the background (several colours), the cost image varies with the geometry.
+  for (const char* name : {"a.png", "c.png"}) {
+    int w = 0, h = 0;
+    const std::vector<amalgam::Vec3> px = amalgam::read_image((d / name).string(), w, h);
+    EXPECT_EQ(w, 40) << name;
+    EXPECT_EQ(h, 30) << name;
+    std::set<std::tuple<float, float, float>> colours;
+    for (const amalgam::Vec3& c : px) colours.insert({c.x, c.y, c.z});
+    EXPECT_GE(colours.size(), 3u) << name << " is (nearly) one colour";
+  }
   std::ifstream in(d / "s.json");
   const auto j = nlohmann::json::parse(in);
   for (const char* key : {"renderer", "opacity", "level", "footprint", "scene", "rays", "tests",
@@ -74,6 +101,62 @@ TEST(Cli, RenderWritesImageCostImageAndStats) {
             t["total"]);
   EXPECT_EQ(levels, t["total"]);
   EXPECT_EQ(j["rays"]["primary"], 40 * 30 * 2);
+  fs::remove_all(d);
+}
+
+// The cost image holds, per pixel, the intersection tests of its samples (primary and shadow
+// rays) divided by spp: raw in .pfm, so the pixels add up to the stats' total exactly; in .png
+// the same counts in false colour, viridis on a log scale (log1p(v) / log1p(max)).
+TEST(Cli, CostImageCountsAddUpToTheStatsAndPngIsViridisOnALogScale) {
+  const fs::path d = temp_dir() / "cost";
+  fs::create_directories(d);
+  const std::string common =
+      "render builtin:prisms --set depth=4 --set view=corner --level 2 --width 40 --height 30 "
+      "--spp 2 --seed 5 --quiet ";
+  ASSERT_EQ(run(common + "--out " + (d / "a.pfm").string() + " --cost-image " +
+                (d / "c.pfm").string() + " --stats " + (d / "s.json").string())
+                .status,
+            0);
+  ASSERT_EQ(
+      run(common + "--out " + (d / "b.pfm").string() + " --cost-image " + (d / "c.png").string())
+          .status,
+      0);
+  std::ifstream in(d / "s.json");
+  const auto j = nlohmann::json::parse(in);
+  int w = 0, h = 0;
+  const std::vector<amalgam::Vec3> raw = amalgam::read_image((d / "c.pfm").string(), w, h);
+  ASSERT_EQ(w, 40);
+  ASSERT_EQ(h, 30);
+  std::vector<double> counts;
+  double sum = 0, lo = 1e300, hi = 0;
+  for (const amalgam::Vec3& v : raw) {
+    EXPECT_EQ(v.x, v.y);
+    EXPECT_EQ(v.x, v.z);
+    const double tests = 2.0 * v.x;  // per pixel: tests of its 2 samples / spp
+    EXPECT_EQ(tests, std::floor(tests)) << "not a whole number of tests: " << tests;
+    EXPECT_GE(v.x, 1.0f) << "every primary ray tests at least the root";
+    counts.push_back(v.x);
+    sum += tests, lo = std::min<double>(lo, v.x), hi = std::max<double>(hi, v.x);
+  }
+  EXPECT_EQ(sum, j["tests"]["total"].get<double>())
+      << "the cost image's pixels add up to the total";
+  EXPECT_LT(lo, hi) << "the cost varies over the image";
+  EXPECT_NEAR(j["per_primary_ray"]["mean"].get<double>() * 40 * 30 * 2, sum, 1e-6 * sum);
+
+  const std::vector<amalgam::Vec3> png = amalgam::read_image((d / "c.png").string(), w, h);
+  ASSERT_EQ(w, 40);
+  ASSERT_EQ(h, 30);
+  const std::vector<amalgam::Vec3> expected = amalgam::false_colour(counts, true);
+  for (std::size_t i = 0; i < png.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      ASSERT_NEAR(amalgam::linear_to_srgb(png[i][c]), amalgam::linear_to_srgb(expected[i][c]),
+                  0.5 / 255 + 1e-6)
+          << "pixel " << i << " channel " << c << " (count " << counts[i] << ")";
+  // The most expensive pixel is viridis' top, #fde725 (matplotlib's viridis(1.0)).
+  const std::size_t top = std::max_element(counts.begin(), counts.end()) - counts.begin();
+  EXPECT_NEAR(amalgam::linear_to_srgb(png[top].x) * 255, 0xfd, 1.0);
+  EXPECT_NEAR(amalgam::linear_to_srgb(png[top].y) * 255, 0xe7, 1.0);
+  EXPECT_NEAR(amalgam::linear_to_srgb(png[top].z) * 255, 0x25, 1.0);
   fs::remove_all(d);
 }
 
@@ -167,6 +250,69 @@ TEST(Cli, HelpForEverySubcommand) {
     EXPECT_NE(s.out.find(name), std::string::npos) << name;
 }
 
+/// The names in directory `d`, sorted.
+std::vector<std::string> entries(const fs::path& d) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(d)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// The lines of `err_file`.
+std::vector<std::string> lines_of(const fs::path& err_file) {
+  std::ifstream in(err_file);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// A write that fails half-way (an injected error: the file size limit of `ulimit -f`, which
+// binds root too, with SIGXFSZ ignored so that write(2) returns EFBIG): exit 1, an error naming
+// the image, the previous file intact byte for byte, no temporary left; for every image format.
+TEST(Cli, AWriteFailingHalfWayLeavesThePreviousFileIntact) {
+  const fs::path d = temp_dir() / "halfway";
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const std::string err = (temp_dir() / "halfway-err.txt").string();
+  for (const char* ext : {"pfm", "png", "exr"}) {
+    SCOPED_TRACE(ext);
+    const fs::path out = d / (std::string("x.") + ext);
+    std::ofstream(out, std::ios::binary) << "the previous " << ext;
+    // 128 x 128 noisy pixels: far more than the 4 KiB allowed, whatever the compression.
+    const std::string cmd = "bash -c \"trap '' XFSZ; ulimit -f 4; exec " +
+                            std::string(AMALGAM_BINARY) +
+                            " render builtin:prisms --set depth=6 --width 128 --height 128 "
+                            "--spp 1 --quiet --out " +
+                            out.string() + "\" 2>" + err;
+    const int st = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(st));
+    EXPECT_EQ(WEXITSTATUS(st), 1);
+    // The first line names the image and why; a renderer that goes on to save the finished
+    // render in a checkpoint, and to list what was not written, may add lines of its own.
+    const std::vector<std::string> lines = lines_of(err);
+    ASSERT_GE(lines.size(), 1u);
+    EXPECT_EQ(lines[0].rfind("amalgam: " + out.string() + ": ", 0), 0u) << lines[0];
+    for (const std::string& l : lines) EXPECT_EQ(l.rfind("amalgam: ", 0), 0u) << l;
+    EXPECT_EQ(slurp(out), std::string("the previous ") + ext);
+    EXPECT_EQ(entries(d).size(), 1u) << "a temporary was left: " << entries(d).back();
+    fs::remove(out);
+  }
+  // The same command without the limit succeeds: the limit is what failed it.
+  const fs::path out = d / "x.pfm";
+  EXPECT_EQ(run("render builtin:prisms --set depth=6 --width 128 --height 128 --spp 1 --quiet "
+                "--out " +
+                out.string())
+                .status,
+            0);
+  EXPECT_EQ(fs::file_size(out), std::string("PF\n128 128\n-1.0\n").size() + 128u * 128u * 12u);
+  fs::remove_all(d);
+}
+
 }  // namespace
 
 namespace {
@@ -212,25 +358,45 @@ TEST(CliLimits, MaxMemoryCountsInstancedScenes) {
   fs::remove_all(d);
 }
 
+/// Starts `cmd` (its stdout read later by `finish`): several renders run side by side.
+FILE* start(const std::string& cmd) {
+  return popen(cmd.c_str(), "r");
+}
+
+std::string finish(FILE* p) {
+  std::string out;
+  char buf[4096];
+  std::size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  pclose(p);
+  return out;
+}
+
+// The progress bar (with its ETA) appears on a terminal after a second, never on a pipe, and
+// --quiet turns it off on a terminal too (with the closing summary line). The three renders run
+// side by side, so each lasts the same (> 1 s: long enough for the bar to show).
 TEST(CliLimits, ProgressBarOnlyOnATerminal) {
   const fs::path d = temp_dir();
   const std::string args = std::string(AMALGAM_BINARY) +
                            " render builtin:prisms --set depth=8 --set view=corner --width 256 "
-                           "--height 256 --spp 20 --threads 1 --out " +
-                           (d / "p.pfm").string();
-  // Not a terminal: no progress bar.
-  const CliRun plain = run(args.substr(std::string(AMALGAM_BINARY).size()) + " 2>&1");
-  EXPECT_EQ(plain.out.find("ETA"), std::string::npos) << plain.out;
-  // A pseudo-terminal (util-linux `script`): the bar with its ETA appears after a second.
+                           "--height 256 --spp 20 --threads 1 --out ";
   ASSERT_EQ(std::system("command -v script >/dev/null 2>&1"), 0) << "script(1) (bsdutils) missing";
-  FILE* p = popen(("script -qec '" + args + "' /dev/null").c_str(), "r");
-  std::string tty;
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) tty.append(buf, n);
-  pclose(p);
-  EXPECT_NE(tty.find("ETA"), std::string::npos) << tty;
-  EXPECT_NE(tty.find("spp"), std::string::npos) << tty;
+  // A pseudo-terminal (util-linux `script`) for the second and third.
+  FILE* plain = start(args + (d / "p.pfm").string() + " 2>&1");
+  FILE* tty = start("script -qec '" + args + (d / "t.pfm").string() + "' /dev/null");
+  FILE* quiet = start("script -qec '" + args + (d / "q.pfm").string() + " --quiet' /dev/null");
+  const std::string plain_out = finish(plain), tty_out = finish(tty), quiet_out = finish(quiet);
+  // Not a terminal: no progress bar.
+  EXPECT_EQ(plain_out.find("ETA"), std::string::npos) << plain_out;
+  // A terminal: the bar with its ETA.
+  EXPECT_NE(tty_out.find("ETA"), std::string::npos) << tty_out;
+  EXPECT_NE(tty_out.find("spp"), std::string::npos) << tty_out;
+  EXPECT_NE(tty_out.find("amalgam: wrote"), std::string::npos) << tty_out;
+  // A terminal with --quiet: nothing at all, and the image is still written.
+  EXPECT_EQ(quiet_out.find("ETA"), std::string::npos) << quiet_out;
+  EXPECT_EQ(quiet_out.find("amalgam: wrote"), std::string::npos) << quiet_out;
+  EXPECT_EQ(quiet_out.find_first_not_of("\r\n"), std::string::npos) << quiet_out;
+  for (const char* f : {"p.pfm", "t.pfm", "q.pfm"}) EXPECT_TRUE(fs::exists(d / f)) << f;
   fs::remove_all(d);
 }
 

@@ -1,19 +1,20 @@
 // The two-level instanced hierarchy against the same scene expanded into one explicit
 // hierarchy, and the scene file producing it.
 
-#include "amalgam/traverse/traverse.h"
-#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/hierarchy/instanced.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <numbers>
 
+#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/math/random.h"
 #include "amalgam/render/render.h"
+#include "amalgam/traverse/traverse.h"
 
 namespace amalgam {
 namespace {
@@ -205,7 +206,9 @@ TEST(Instanced, CountsAddUpAndLevelsRunThroughInstances) {
 
 TEST(Instanced, SceneFileKeepsLargeMeshesInstanced) {
   namespace fs = std::filesystem;
-  const fs::path d = fs::temp_directory_path() / "amalgam_instanced_test";
+  // Named by the process: another suite (another worktree's) may run this test at once.
+  const fs::path d =
+      fs::temp_directory_path() / ("amalgam_instanced_test_" + std::to_string(::getpid()));
   fs::create_directories(d);
   {
     std::ofstream obj(d / "grid.obj");  // 8 x 8 quads: 128 triangles

@@ -34,6 +34,33 @@ TEST(Colormap, FalseColourIsMonotonicInLuminance) {
   EXPECT_GT(luminance(false_colour(small, true)[0]), luminance(false_colour(small, false)[0]));
 }
 
+/// An 8-bit sRGB code of a linear value (IEC 61966-2-1, written out here).
+int srgb_code(float v) {
+  const double s = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(double(v), 1 / 2.4) - 0.055;
+  return static_cast<int>(std::lround(255 * s));
+}
+
+// The published viridis (matplotlib's _viridis_data, as hex) at t = 0, 1/4, 1/2, 3/4 and 1:
+// #440154, #3b528b, #21918c, #5ec962, #fde725. On a linear scale t = v / max; on the log
+// scale t = log1p(v) / log1p(max), so v = e^(4t) - 1 with max e^4 - 1 hits the same five.
+TEST(Colormap, FalseColourIsPublishedViridisOnTheStatedScale) {
+  const int hex[5][3] = {{0x44, 0x01, 0x54},
+                         {0x3b, 0x52, 0x8b},
+                         {0x21, 0x91, 0x8c},
+                         {0x5e, 0xc9, 0x62},
+                         {0xfd, 0xe7, 0x25}};
+  const std::vector<double> linear = {0, 1, 2, 3, 4};
+  std::vector<double> log_spaced;
+  for (int k = 0; k <= 4; ++k) log_spaced.push_back(std::expm1(k));
+  for (bool log_scale : {false, true}) {
+    const std::vector<Vec3> c = false_colour(log_scale ? log_spaced : linear, log_scale);
+    for (int k = 0; k <= 4; ++k)
+      for (int ch = 0; ch < 3; ++ch)
+        EXPECT_NEAR(srgb_code(c[k][ch]), hex[k][ch], 2)
+            << (log_scale ? "log" : "linear") << " scale, t = " << k / 4.0 << ", channel " << ch;
+  }
+}
+
 TEST(Colormap, FalseColourEdgeCases) {
   double vmax = -1;
   EXPECT_TRUE(false_colour({}, false, &vmax).empty());

@@ -1,6 +1,7 @@
 #include "amalgam/io/image.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -223,6 +225,77 @@ TEST(Image, WritingIntoMissingDirectoryThrowsAndLeavesNothing) {
     EXPECT_FALSE(fs::exists(missing));
   }
   EXPECT_TRUE(dir.entries().empty());
+}
+
+/// While alive, the process may not write files beyond `bytes` (RLIMIT_FSIZE binds root too)
+/// and a write beyond fails with EFBIG instead of raising SIGXFSZ: an injected write error.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    getrlimit(RLIMIT_FSIZE, &old_);
+    old_handler_ = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit lim = old_;
+    lim.rlim_cur = bytes;
+    EXPECT_EQ(setrlimit(RLIMIT_FSIZE, &lim), 0);
+  }
+  ~FileSizeLimit() {
+    setrlimit(RLIMIT_FSIZE, &old_);
+    std::signal(SIGXFSZ, old_handler_);
+  }
+  FileSizeLimit(const FileSizeLimit&) = delete;
+  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+
+ private:
+  rlimit old_{};
+  void (*old_handler_)(int) = nullptr;
+};
+
+/// Noise: incompressible, so every format needs about its raw size.
+std::vector<Vec3> noise(int w, int h) {
+  std::vector<Vec3> px;
+  std::uint32_t s = 12345;
+  auto next = [&] { return (s = s * 1664525u + 1013904223u) / 4294967296.0f; };
+  for (int i = 0; i < w * h; ++i) px.push_back({next(), next(), next()});
+  return px;
+}
+
+// Writing fails half-way (the file size limit stops it after 4 KiB): ImageIoError naming the
+// file, the previous file intact, no temporary left, for every format; without the limit the
+// same write succeeds (so the limit is what failed it).
+TEST(Image, AWriteFailingHalfWayKeepsThePreviousFileAndNoTemporary) {
+  ScopedTempDir dir;
+  const std::vector<Vec3> px = noise(64, 64);  // >= 12 KiB in every format
+  for (const char* name : {"x.png", "x.pfm", "x.exr"}) {
+    SCOPED_TRACE(name);
+    const std::string path = dir.file(name);
+    std::ofstream(path, std::ios::binary) << "previous contents";
+    std::string msg;
+    {
+      FileSizeLimit limit(4096);
+      msg = error_of([&] { write_image(path, 64, 64, px); });
+    }
+    EXPECT_EQ(msg.rfind(path + ": ", 0), 0u) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    EXPECT_EQ(read_bytes(path), "previous contents");
+    EXPECT_EQ(dir.entries(), std::vector<std::string>{name}) << "a temporary was left";
+    write_image(path, 64, 64, px);
+    EXPECT_GT(fs::file_size(path), 4096u);
+    fs::remove(path);
+  }
+}
+
+// The destination is a directory: the temporary is written, the rename fails; the directory
+// and its contents are untouched and the temporary is gone.
+TEST(Image, ADestinationThatIsADirectoryIsUntouched) {
+  ScopedTempDir dir;
+  fs::create_directories(dir.path() / "x.png");
+  std::ofstream(dir.path() / "x.png" / "inside") << "kept";
+  const std::string path = dir.file("x.png");
+  const std::string msg = error_of([&] { write_image(path, 6, 5, test_pattern(6, 5)); });
+  EXPECT_EQ(msg.rfind(path + ": ", 0), 0u) << msg;
+  EXPECT_TRUE(fs::is_directory(path));
+  EXPECT_EQ(read_bytes((dir.path() / "x.png" / "inside").string()), "kept");
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"x.png"}) << "a temporary was left";
 }
 
 TEST(Image, NoTemporaryFileLeftAfterSuccess) {
