@@ -13,6 +13,7 @@
 #include "amalgam/io/checkpoint.h"
 #include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
+#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/io/stats_json.h"
 #include "amalgam/util/atomic_file.h"
 #include "amalgam/load/load_scene.h"
@@ -92,28 +93,11 @@ std::uint64_t physical_memory() {
          static_cast<std::uint64_t>(sysconf(_SC_PAGE_SIZE));
 }
 
-/// Bytes a render of these options needs beyond the scene: film buffers and per-thread state.
+/// Bytes a render of these options needs beyond the scene: the process and the film (sums,
+/// tests, image and cost per pixel; MemoryModel, hierarchy/build/build.h).
 std::uint64_t film_bytes(const RenderOptions& o) {
   const std::uint64_t pixels = static_cast<std::uint64_t>(o.width) * o.height;
-  return pixels * (3 * sizeof(Vec3) + 3 * sizeof(std::uint64_t)) + (64u << 20);
-}
-
-std::uint64_t explicit_bytes(const ExplicitHierarchy& e) {
-  return e.nodes.size() * (sizeof(ExplicitNode) + sizeof(Appearance)) +
-         e.prims.size() * sizeof(Primitive) + e.materials.size() * sizeof(Surface);
-}
-
-/// Bytes of the scene's stored parts (the builtins' implicit hierarchies store none).
-std::uint64_t scene_bytes(const LoadedScene& s) {
-  if (const auto* e = std::get_if<ExplicitHierarchy>(&s.hierarchy)) return explicit_bytes(*e);
-  if (const auto* in = std::get_if<InstancedHierarchy>(&s.hierarchy)) {
-    std::uint64_t b = in->top_nodes.size() * (sizeof(ExplicitNode) + sizeof(Appearance)) +
-                      in->top_items.size() * sizeof(std::uint32_t) +
-                      in->instances.size() * sizeof(InstancedHierarchy::InstanceData);
-    for (const ExplicitHierarchy& m : in->meshes) b += explicit_bytes(m);
-    return b;
-  }
-  return 0;
+  return MemoryModel::kProcess + pixels * MemoryModel::kPerPixel;
 }
 
 std::string human_bytes(double b) {
@@ -184,12 +168,12 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
                      std::to_string(o.height) + ": the film needs " + human_bytes(film) +
                      ", more than --max-memory " + human_bytes(limit));
   set_activity("loading and building " + common.scene);
-  const LoadedScene scene = load_scene(common.scene, common.params());
+  SceneFileConfig budget;  // checked before the scene is built (MemoryModel)
+  budget.max_bytes = limit - film;
+  budget.limit_name = "--max-memory " + human_bytes(static_cast<double>(limit)) + " less " +
+                      human_bytes(static_cast<double>(film)) + " for the film";
+  const LoadedScene scene = load_scene(common.scene, common.params(), budget);
   check_options(scene, o);
-  if (film + scene_bytes(scene) > limit)
-    throw InputError(common.scene + ": scene and film need " +
-                     human_bytes(film + scene_bytes(scene)) + ", more than --max-memory " +
-                     human_bytes(limit));
 
   const std::string fp = fingerprint(common, scene);
   FilmState state;

@@ -5,7 +5,9 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/resource.h>
 #include <sys/sysmacros.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -14,6 +16,7 @@
 #include <fstream>
 #include <future>
 #include <iterator>
+#include <regex>
 #include <string>
 
 namespace {
@@ -221,6 +224,50 @@ TEST(OutOfMemory, OneLineNamingTheWorkExitOneNoCoreDump) {
   const std::string err = slurp(d / "err.txt");
   EXPECT_EQ(err, "amalgam: out of memory while loading and building " + (d / "big.json") + "\n");
   EXPECT_FALSE(fs::exists(d / "x.png"));
+}
+#endif
+
+#if !defined(__SANITIZE_ADDRESS__)  // ASan's shadow memory is part of its resident set
+/// Runs amalgam with `args`; its peak resident set in bytes (wait4), -1 if it failed.
+double peak_bytes(const std::string& args) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const std::string cmd = std::string(AMALGAM_BINARY) + " " + args + " 2>/dev/null";
+    execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int st = 0;
+  struct rusage ru {};
+  if (wait4(pid, &st, 0, &ru) != pid || !WIFEXITED(st) || WEXITSTATUS(st) != 0) return -1;
+  return static_cast<double>(ru.ru_maxrss) * 1024.0;
+}
+
+TEST(MaxMemory, EstimatedBeforeBuildingWithin25PercentOfThePeak) {
+  Dir d("memory");
+  const std::string wuson = "/usr/share/assimp/models/PLY/Wuson.ply";
+  std::ofstream(d / "explicit.json")  // 238,848 triangles in one tree
+      << R"({"meshes": [{"file": ")" << wuson << R"(", "subdivide": 3}]})";
+  std::ofstream(d / "instanced.json")  // the same mesh, placed 100 times as instances
+      << R"({"meshes": [{"name": "w", "file": ")" << wuson << R"(", "subdivide": 3, "place": false}],
+            "instances": [{"mesh": "w", "grid": {"nx": 10, "nz": 10, "spacing": 2}}]})";
+  std::ofstream(d / "many.json")  // 100,000 instances of a small mesh
+      << R"({"meshes": [{"name": "w", "file": ")" << wuson << R"("}],
+            "instances": [{"mesh": "w", "grid": {"nx": 400, "nz": 250, "spacing": 2}}]})";
+  const std::string film = " --width 8 --height 8 --spp 1 --quiet --out " + (d / "x.png");
+  for (const char* scene : {"explicit.json", "instanced.json", "many.json"}) {
+    // The estimate, from the refusal (before building: at once, no output).
+    const CliResult r = amalgam("render " + (d / scene) + film + " --max-memory 9M");
+    ASSERT_EQ(r.status, 2) << scene << ": " << r.err;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(r.err, m, std::regex("needs about ([0-9.]+) MiB"))) << r.err;
+    const double estimate = (std::stod(m[1]) + 8.0) * 1048576.0;  // + the process and 8x8 film
+    EXPECT_FALSE(fs::exists(d / "x.png"));
+    const double peak = peak_bytes("render " + (d / scene) + film);
+    ASSERT_GT(peak, 0.0) << scene << " did not render";
+    EXPECT_NEAR(estimate / peak, 1.0, 0.25)
+        << scene << ": estimate " << estimate / 1048576 << " MiB, peak " << peak / 1048576 << " MiB";
+    fs::remove(d / "x.png");
+  }
 }
 #endif
 

@@ -9,9 +9,11 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
+#include <iomanip>
 #include <sstream>
 
 #include "amalgam/io/json_reader.h"
+#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/io/mesh_import.h"
 #include "amalgam/io/scene_json_parts.h"
 #include "amalgam/math/transform.h"
@@ -89,6 +91,13 @@ class SceneParser {
                              " instances, more than the limit of " +
                              fmt(static_cast<double>(config_.max_instances)));
       }
+    }
+    if (config_.max_bytes) {  // before any triangle is expanded or built
+      std::uint64_t instanced = 0;
+      std::set<const MeshEntry*> seen;
+      for (const Placement& p : placements)
+        if (!p.expand && seen.insert(p.mesh).second) instanced += p.mesh->mesh->triangles.size();
+      check_memory(r_.file(), MemoryModel::scene(total, instanced, kept), config_);
     }
     out_.prims.reserve(total);
     out_.instances.reserve(kept);
@@ -436,6 +445,22 @@ std::size_t first_invalid_utf8(const std::string& s) {
 }
 
 }  // namespace
+
+std::string format_bytes(double b) {
+  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
+  int u = 0;
+  while (b >= 1024 && u < 4) b /= 1024, ++u;
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(u ? 1 : 0) << b << " " << units[u];
+  return s.str();
+}
+
+void check_memory(const std::string& where, std::uint64_t need, const SceneFileConfig& config) {
+  if (config.max_bytes == 0 || need <= config.max_bytes) return;
+  throw InputError(where + ": the scene needs about " + format_bytes(static_cast<double>(need)) +
+                   " (estimated before building, within about 25 %), more than " +
+                   config.limit_name);
+}
 
 SceneDescription parse_scene_json(const std::string& text, const std::string& path,
                                   const SceneFileConfig& config) {

@@ -24,7 +24,19 @@ struct SceneFileConfig {
   std::uint64_t instance_min_triangles = 64;
   /// Instances kept as instances beyond this are an InputError (about 250 bytes each).
   std::uint64_t max_instances = 20'000'000;
+  /// Bytes the built scene may take (0: no limit), checked before any triangle is expanded or
+  /// built, with MemoryModel (hierarchy/build/build.h); `limit_name` names the limit in the
+  /// message (e.g. "--max-memory 100 MiB less the film").
+  std::uint64_t max_bytes = 0;
+  std::string limit_name = "the memory limit";
 };
+
+/// "12.3 MiB": a byte count for messages.
+std::string format_bytes(double bytes);
+
+/// Throws InputError "<where>: the scene needs about X (estimated before building: ...), more
+/// than <limit>" when `need` exceeds config.max_bytes (a limit of 0 is none).
+void check_memory(const std::string& where, std::uint64_t need, const SceneFileConfig& config);
 
 /// Reads a scene file. Relative mesh paths resolve against the file's folder. Throws
 /// InputError naming the file and, for JSON syntax errors, the line and column, otherwise the

@@ -32,6 +32,7 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
   ic.max_triangles = config.max_triangles;
   ImportedMesh m = import_mesh(path, ic);
   check_extent(m.bounds, path);
+  check_memory(path, MemoryModel::scene(m.triangles.size(), 0, 0), config);
   SceneDescription d;
   d.prims = std::move(m.triangles);
   d.materials = std::move(m.materials);
@@ -57,14 +58,15 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   return s;
 }
 
-LoadedScene load_scene(const std::string& spec, const Params& params) {
+LoadedScene load_scene(const std::string& spec, const Params& params,
+                       const SceneFileConfig& config) {
   if (spec.rfind("builtin:", 0) == 0) return load_builtin(spec, params);
   std::error_code ec;
   const bool exists = std::filesystem::exists(spec, ec);
   if (ec) throw InputError(spec + ": " + ec.message());  // e.g. a symbolic link loop
   if (!exists) throw InputError(spec + ": no such file");
   params.check_all_used();       // --set configures builtin scenes only
-  return load_scene_path(spec);  // .json scene file or mesh; times its own load and build
+  return load_scene_path(spec, config);  // .json or mesh; times its own load and build
 }
 
 }  // namespace amalgam

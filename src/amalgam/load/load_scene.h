@@ -25,7 +25,10 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
 /// and bakes its hierarchy (build_hierarchy). Sets load_seconds (reading) and build_seconds.
 LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config = {});
 
-/// Loads `spec`. Throws InputError (one line naming the scene and the problem) on bad input.
-LoadedScene load_scene(const std::string& spec, const Params& params);
+/// Loads `spec`. Throws InputError (one line naming the scene and the problem) on bad input,
+/// including a scene file or mesh that would take more than `config.max_bytes` (checked before
+/// building; the builtin scenes are implicit and take no memory to speak of).
+LoadedScene load_scene(const std::string& spec, const Params& params,
+                       const SceneFileConfig& config = {});
 
 }  // namespace amalgam

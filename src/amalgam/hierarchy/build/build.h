@@ -2,6 +2,7 @@
 /// \file Builders of the stored hierarchy forms: a binned SAH tree (build/sah.h), collapsed to
 /// wide nodes, then baked (bake/bake.h).
 
+#include <cstdint>
 #include <vector>
 
 #include "amalgam/hierarchy/bake/bake.h"
@@ -9,6 +10,28 @@
 #include "amalgam/hierarchy/instanced.h"
 
 namespace amalgam {
+
+/// Memory a built scene takes at its peak (reading, building and baking included), as measured
+/// with this build's default settings (max resident set of `amalgam render` at 8x8 pixels,
+/// docs/reliability.md "Resource limits"): for an explicit hierarchy about 215-250 bytes per
+/// triangle (the triangles as read, the SAH's temporaries, nodes, appearances, SIMD child boxes
+/// and triangle packs, the bake's tensors); for an instanced one, per instance (its transform
+/// data, the top-level tree and its bake) about 320 bytes. Small scenes (under about 30 MiB)
+/// are overestimated, by up to 40 % (the allocator reuses the memory of the process), which
+/// errs on the safe side.
+struct MemoryModel {
+  static constexpr std::uint64_t kProcess = 8u << 20;       ///< the process before any scene
+  static constexpr std::uint64_t kSceneFile = 8u << 20;     ///< reading a scene file or mesh
+  static constexpr std::uint64_t kPerTriangle = 250;        ///< explicit hierarchy, at its peak
+  static constexpr std::uint64_t kPerInstance = 320;        ///< instanced hierarchy
+  static constexpr std::uint64_t kPerPixel = 44;            ///< film: sums, tests, image, cost
+  /// Bytes a scene file of `triangles` triangles built explicitly (loose or expanded), plus
+  /// `instances` placements of instanced meshes of `instanced_triangles` in all, takes.
+  static constexpr std::uint64_t scene(std::uint64_t triangles, std::uint64_t instanced_triangles,
+                                       std::uint64_t instances) {
+    return kSceneFile + (triangles + instanced_triangles) * kPerTriangle + instances * kPerInstance;
+  }
+};
 
 /// Build settings for `build_explicit` and `build_instanced`.
 struct BuildConfig {
