@@ -40,8 +40,8 @@
 #include <thread>
 #include <vector>
 
-#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/hierarchy/bake/bake.h"
+#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/hierarchy/explicit.h"
 #include "amalgam/io/mesh_import.h"
 #include "amalgam/traverse/lod.h"

@@ -50,8 +50,8 @@
 #include <string>
 #include <vector>
 
-#include "amalgam/io/image.h"
 #include "amalgam/analysis/metrics.h"
+#include "amalgam/io/image.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/integrator.h"
 #include "amalgam/render/passes.h"

@@ -4,8 +4,8 @@
 
 #include <benchmark/benchmark.h>
 
-#include "amalgam/render/integrator.h"
 #include "amalgam/load/load_scene.h"
+#include "amalgam/render/integrator.h"
 
 namespace amalgam {
 namespace {
@@ -18,8 +18,8 @@ void trace_image(benchmark::State& state, const char* scene_depth, Lod lod) {
   const LoadedScene scene = load_scene("builtin:prisms", p);
   const auto& h = std::get<PrismsHierarchy>(scene.hierarchy);
   Stats stats;
-  Integrator<PrismsHierarchy, Lod, StochasticOpacity, SortedOrder, Stats> integ(h, scene.env,
-                                                                                 lod, stats);
+  Integrator<PrismsHierarchy, Lod, StochasticOpacity, SortedOrder, Stats> integ(h, scene.env, lod,
+                                                                                stats);
   const int w = 128, hgt = 128;
   std::uint64_t rays = 0;
   for (auto _ : state) {
@@ -36,11 +36,15 @@ void trace_image(benchmark::State& state, const char* scene_depth, Lod lod) {
       benchmark::Counter(static_cast<double>(rays), benchmark::Counter::kIsRate);
 }
 
-void Traditional_Counted(benchmark::State& s) { trace_image<Counters>(s, "7", TraditionalLod{}); }
+void Traditional_Counted(benchmark::State& s) {
+  trace_image<Counters>(s, "7", TraditionalLod{});
+}
 void Traditional_Uncounted(benchmark::State& s) {
   trace_image<NullCounters>(s, "7", TraditionalLod{});
 }
-void Footprint_Counted(benchmark::State& s) { trace_image<Counters>(s, "10", FootprintLod{1.0f}); }
+void Footprint_Counted(benchmark::State& s) {
+  trace_image<Counters>(s, "10", FootprintLod{1.0f});
+}
 void Footprint_Uncounted(benchmark::State& s) {
   trace_image<NullCounters>(s, "10", FootprintLod{1.0f});
 }

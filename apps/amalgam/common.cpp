@@ -14,22 +14,24 @@ void CommonOptions::add_to(CLI::App& app) {
       ->check(CLI::IsMember({"scale-sensitive", "traditional"}));
   app.add_option("--opacity", opacity, "stochastic (default) or deterministic")
       ->check(CLI::IsMember({"stochastic", "deterministic"}));
-  level_option = app.add_option("--level", level, "scale-sensitive: render the amalgams met on level L")
-      ->check(non_negative_int());
-  footprint_option = app.add_option("--footprint", footprint,
-                 "scale-sensitive without --level: render an amalgam once it is smaller than K "
-                 "pixels of ray footprint (default 1)")
-      ->check(CLI::Validator(
-          [](std::string& v) -> std::string {
-            try {
-              std::size_t end = 0;
-              const double x = std::stod(v, &end);
-              if (end == v.size() && x > 0.0 && x < 1e30) return "";
-            } catch (const std::exception&) {
-            }
-            return "expected a number > 0";
-          },
-          "K > 0"));
+  level_option =
+      app.add_option("--level", level, "scale-sensitive: render the amalgams met on level L")
+          ->check(non_negative_int());
+  footprint_option =
+      app.add_option("--footprint", footprint,
+                     "scale-sensitive without --level: render an amalgam once it is smaller than K "
+                     "pixels of ray footprint (default 1)")
+          ->check(CLI::Validator(
+              [](std::string& v) -> std::string {
+                try {
+                  std::size_t end = 0;
+                  const double x = std::stod(v, &end);
+                  if (end == v.size() && x > 0.0 && x < 1e30) return "";
+                } catch (const std::exception&) {
+                }
+                return "expected a number > 0";
+              },
+              "K > 0"));
   app.add_option("--order", order, "sorted (default): nearest child first; unsorted: stored order")
       ->check(CLI::IsMember({"sorted", "unsorted"}));
   app.add_option("--seed", seed, "seed of all randomness, 0 .. 2^64-1 (default 0)");
@@ -86,7 +88,9 @@ void set_activity(std::string what) {
   g_activity = std::move(what);
 }
 
-const std::string& activity() { return g_activity; }
+const std::string& activity() {
+  return g_activity;
+}
 
 const CLI::Validator& positive_int() {
   static const CLI::Validator v = int_in(1, 2147483647, "an integer >= 1");
@@ -120,8 +124,8 @@ std::uint64_t parse_bytes(const std::string& text, const std::string& option) {
   bool ok = ec == std::errc() && p != b;
   if (ok && !suffix.empty()) {
     const auto u = units.find(suffix[0]);
-    ok = u != std::string::npos && (suffix.size() == 1 || suffix.substr(1) == "B" ||
-                                     suffix.substr(1) == "IB");
+    ok = u != std::string::npos &&
+         (suffix.size() == 1 || suffix.substr(1) == "B" || suffix.substr(1) == "IB");
     shift = ok ? 10 * (static_cast<int>(u) + 1) : 0;
   }
   if (ok && shift && x > (std::uint64_t{~0ull} >> shift)) ok = false;

@@ -59,7 +59,7 @@ struct RenderExtras {
   std::string out, stats, cost_image, checkpoint;
   bool resume = false;
   bool quiet = false;
-  std::string max_memory;  ///< as given (parse_bytes); empty: the machine's physical memory
+  std::string max_memory;          ///< as given (parse_bytes); empty: the machine's physical memory
   double checkpoint_every = 60.0;  ///< seconds between checkpoints during a render
 };
 

@@ -7,10 +7,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "amalgam/analysis/metrics.h"
 #include "amalgam/builtin/params.h"
 #include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
-#include "amalgam/analysis/metrics.h"
 #include "common.h"
 
 namespace amalgam::cli {

@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
-#include <new>
 #include <iostream>
+#include <new>
 
 #include "amalgam/util/error.h"
 #include "common.h"
@@ -34,8 +34,9 @@ namespace {
 int main(int argc, char** argv) {
   using namespace amalgam;
   std::set_terminate(on_terminate);
-  CLI::App app{"amalgam: a ray tracer with renderable bounding volumes (amalgams), after "
-               "Thompson & Fussell, 'Time Costs of Ray Tracing with Amalgams' (1991)"};
+  CLI::App app{
+      "amalgam: a ray tracer with renderable bounding volumes (amalgams), after "
+      "Thompson & Fussell, 'Time Costs of Ray Tracing with Amalgams' (1991)"};
   app.require_subcommand(1);
 
   cli::CommonOptions render_opts;
@@ -60,9 +61,10 @@ int main(int argc, char** argv) {
   render->add_option("--max-memory", extras.max_memory,
                      "fail early if the render needs more bytes than this (suffixes K, M, G, T; "
                      "default: physical memory)");
-  render->add_option("--checkpoint-every", extras.checkpoint_every,
-                     "seconds between checkpoints while rendering (default 60; 0: after every "
-                     "pass of samples)")
+  render
+      ->add_option("--checkpoint-every", extras.checkpoint_every,
+                   "seconds between checkpoints while rendering (default 60; 0: after every "
+                   "pass of samples)")
       ->check(CLI::Validator(
           [](std::string& v) -> std::string {
             try {

@@ -10,12 +10,11 @@
 #include <iostream>
 #include <sstream>
 
+#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/io/checkpoint.h"
 #include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
-#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/io/stats_json.h"
-#include "amalgam/util/atomic_file.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
 #include "amalgam/util/atomic_file.h"
@@ -27,7 +26,7 @@ namespace {
 
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
-std::atomic<int> g_signals{0};        ///< SIGINT/SIGTERM received
+std::atomic<int> g_signals{0};         ///< SIGINT/SIGTERM received
 std::atomic<bool> g_finishing{false};  ///< the render is done: its outputs are being written
 
 /// SIGINT/SIGTERM: the first stops the render at the next tile; the image so far and a
@@ -72,8 +71,10 @@ void check_outputs(const RenderExtras& e, const std::string& ckpt) {
     const char* option;
     const std::string& path;
   };
-  const Output outputs[] = {
-      {"--out", e.out}, {"--cost-image", e.cost_image}, {"--stats", e.stats}, {"--checkpoint", ckpt}};
+  const Output outputs[] = {{"--out", e.out},
+                            {"--cost-image", e.cost_image},
+                            {"--stats", e.stats},
+                            {"--checkpoint", ckpt}};
   std::vector<std::pair<std::string, const char*>> files;  // resolved regular files
   for (const Output& o : outputs) {
     if (o.path.empty()) continue;
@@ -228,8 +229,7 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   const std::string json =
       stats_json(scene, o, r.counters, r.per_primary, r.seconds).dump(2) + "\n";
   if (!extra.stats.empty()) attempt(extra.stats, [&] { write_file_atomic(extra.stats, json); });
-  if (r.interrupted || !failed.empty())
-    attempt(ckpt, [&] { write_checkpoint(ckpt, fp, state); });
+  if (r.interrupted || !failed.empty()) attempt(ckpt, [&] { write_checkpoint(ckpt, fp, state); });
   if (!failed.empty()) {
     std::cerr << "amalgam: not written: ";
     for (std::size_t i = 0; i < failed.size(); ++i) std::cerr << (i ? ", " : "") << failed[i];

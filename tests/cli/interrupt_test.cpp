@@ -126,7 +126,8 @@ const std::string kRender =
 int interrupt(const Dir& d, const std::string& out, const std::vector<int>& signals,
               const std::string& extra = "") {
   const pid_t pid = start(kRender + " --spp 1000000 --out " + out + extra, d.path / "err.txt");
-  EXPECT_TRUE(wait_for(out + ".ckpt", pid)) << "no checkpoint appeared: " << slurp(d.path / "err.txt");
+  EXPECT_TRUE(wait_for(out + ".ckpt", pid))
+      << "no checkpoint appeared: " << slurp(d.path / "err.txt");
   for (int s : signals) {
     kill(pid, s);
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -176,7 +177,8 @@ TEST(CliInterrupt, ASecondSignalStillWritesEverythingAndAThirdLeavesNothingHalfW
     // The checkpoint is whole: resuming it is accepted.
     const int held = samples_held(slurp(d.path / "err.txt"));
     ASSERT_GE(held, 1);
-    EXPECT_EQ(run(kRender + " --spp " + std::to_string(held + 1) + " --out " + out + " --resume"), 0);
+    EXPECT_EQ(run(kRender + " --spp " + std::to_string(held + 1) + " --out " + out + " --resume"),
+              0);
   }
   for (int round = 0; round < 3; ++round) {
     Dir d("thrice");
@@ -218,8 +220,9 @@ TEST(CliInterrupt, ResumeRefusesOtherSettingsADamagedCheckpointAndAnEditedScene)
   // A scene file edited between the interrupt and the resume.
   const fs::path scene = d.path / "s.json";
   auto write_scene = [&](const char* colour) {
-    std::ofstream(scene) << R"({"materials": {"m": {"colour": )" << colour
-                         << R"(}}, "spheres": [{"centre": [0, 0, 0], "radius": 1, "material": "m"}]})";
+    std::ofstream(scene)
+        << R"({"materials": {"m": {"colour": )" << colour
+        << R"(}}, "spheres": [{"centre": [0, 0, 0], "radius": 1, "material": "m"}]})";
   };
   write_scene("[0.8, 0.2, 0.2]");
   const std::string sout = (d.path / "scene.pfm").string();

@@ -4,8 +4,8 @@
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
-#include <sys/stat.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -46,7 +46,8 @@ struct CliResult {
 };
 
 CliResult amalgam(const std::string& args) {
-  const std::string err = fs::temp_directory_path() / ("amalgam-rel-err-" + std::to_string(getpid()));
+  const std::string err =
+      fs::temp_directory_path() / ("amalgam-rel-err-" + std::to_string(getpid()));
   const auto t0 = std::chrono::steady_clock::now();
   const int st = std::system((std::string(AMALGAM_BINARY) + " " + args + " 2>" + err).c_str());
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -55,9 +56,11 @@ CliResult amalgam(const std::string& args) {
   return r;
 }
 
-const std::string kSmall = "render builtin:prisms --set depth=3 --width 8 --height 8 --spp 1 --quiet";
+const std::string kSmall =
+    "render builtin:prisms --set depth=3 --width 8 --height 8 --spp 1 --quiet";
 /// A render that takes minutes: an output check that comes only after the work would show.
-const std::string kLong = "render builtin:prisms --set depth=8 --width 512 --height 512 --spp 10000";
+const std::string kLong =
+    "render builtin:prisms --set depth=8 --width 512 --height 512 --spp 10000";
 
 TEST(Outputs, DevicesAndFifosAreWrittenThroughNeverReplaced) {
   Dir d("dev");
@@ -65,8 +68,8 @@ TEST(Outputs, DevicesAndFifosAreWrittenThroughNeverReplaced) {
   // another user, /dev/null itself (which a rename could not replace anyway).
   std::string null = d / "null";
   if (::mknod(null.c_str(), S_IFCHR | 0666, makedev(1, 3)) != 0) null = "/dev/null";
-  const CliResult r = amalgam(kSmall + " --out " + (d / "x.png") + " --stats " + null + " --cost-image " +
-                        (d / "c.png"));
+  const CliResult r = amalgam(kSmall + " --out " + (d / "x.png") + " --stats " + null +
+                              " --cost-image " + (d / "c.png"));
   EXPECT_EQ(r.status, 0) << r.err;
   struct stat st {};
   ASSERT_EQ(::stat(null.c_str(), &st), 0);
@@ -248,7 +251,8 @@ TEST(MaxMemory, EstimatedBeforeBuildingWithin25PercentOfThePeak) {
   std::ofstream(d / "explicit.json")  // 238,848 triangles in one tree
       << R"({"meshes": [{"file": ")" << wuson << R"(", "subdivide": 3}]})";
   std::ofstream(d / "instanced.json")  // the same mesh, placed 100 times as instances
-      << R"({"meshes": [{"name": "w", "file": ")" << wuson << R"(", "subdivide": 3, "place": false}],
+      << R"({"meshes": [{"name": "w", "file": ")" << wuson
+      << R"(", "subdivide": 3, "place": false}],
             "instances": [{"mesh": "w", "grid": {"nx": 10, "nz": 10, "spacing": 2}}]})";
   std::ofstream(d / "many.json")  // 100,000 instances of a small mesh
       << R"({"meshes": [{"name": "w", "file": ")" << wuson << R"("}],
@@ -264,8 +268,8 @@ TEST(MaxMemory, EstimatedBeforeBuildingWithin25PercentOfThePeak) {
     EXPECT_FALSE(fs::exists(d / "x.png"));
     const double peak = peak_bytes("render " + (d / scene) + film);
     ASSERT_GT(peak, 0.0) << scene << " did not render";
-    EXPECT_NEAR(estimate / peak, 1.0, 0.25)
-        << scene << ": estimate " << estimate / 1048576 << " MiB, peak " << peak / 1048576 << " MiB";
+    EXPECT_NEAR(estimate / peak, 1.0, 0.25) << scene << ": estimate " << estimate / 1048576
+                                            << " MiB, peak " << peak / 1048576 << " MiB";
     fs::remove(d / "x.png");
   }
 }

@@ -293,7 +293,8 @@ TEST(Watertight, TessellatedSphereEdgesAndVertices) {
 constexpr const char* kWuson = "/usr/share/assimp/models/PLY/Wuson.ply";
 
 TEST(Watertight, WusonEdgesAndVertices) {
-  ASSERT_TRUE(std::filesystem::exists(kWuson)) << kWuson << " missing (assimp-testmodels, scripts/deps.sh)";
+  ASSERT_TRUE(std::filesystem::exists(kWuson))
+      << kWuson << " missing (assimp-testmodels, scripts/deps.sh)";
   const ImportedMesh imported = import_mesh(kWuson);
   const Mesh m = indexed(imported.triangles);
   const Topology topo = topology(m);
@@ -363,8 +364,8 @@ void expect_finite_image(const std::vector<RenderOutput>& outs, const std::strin
     const RenderOutput& out = outs[k];
     int bright = 0;
     for (std::size_t i = 0; i < out.image.size(); ++i) {
-      ASSERT_TRUE(is_finite(out.image[i])) << what << ", render " << k << ": pixel " << i
-                                           << " is not finite";
+      ASSERT_TRUE(is_finite(out.image[i]))
+          << what << ", render " << k << ": pixel " << i << " is not finite";
       bright += luminance(out.image[i]) > luminance(Environment{}.background) + 0.02f;
     }
     EXPECT_GE(bright, lit) << what << ", render " << k << ": the geometry does not show";

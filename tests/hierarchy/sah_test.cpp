@@ -1,6 +1,5 @@
 // Binned SAH builder and the bake: structural validity and opacity sanity.
 
-#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/hierarchy/build/sah.h"
 
 #include <gtest/gtest.h>
@@ -8,6 +7,7 @@
 #include <cstdio>
 #include <set>
 
+#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/hierarchy/explicit.h"
 #include "amalgam/math/random.h"
 

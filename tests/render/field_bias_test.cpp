@@ -9,10 +9,10 @@
 #include <filesystem>
 #include <numbers>
 
-#include "amalgam/hierarchy/build/build.h"
-#include "amalgam/hierarchy/bake/orientation.h"
-#include "amalgam/hierarchy/bake/lines.h"
 #include "amalgam/geometry/intersect.h"
+#include "amalgam/hierarchy/bake/lines.h"
+#include "amalgam/hierarchy/bake/orientation.h"
+#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/hierarchy/explicit.h"
 #include "amalgam/hierarchy/instanced.h"
 #include "amalgam/io/mesh_import.h"

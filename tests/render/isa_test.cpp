@@ -4,13 +4,14 @@
 // that the portable copy runs on a CPU without AVX2 is checked by the ctest `isa_portable`
 // (tests/isa_portable.sh, under qemu-user emulating a CPU without AVX).
 
+#include "amalgam/util/isa.h"
+
 #include <gtest/gtest.h>
 
 #include "amalgam/hierarchy/build/build.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
 #include "amalgam/render/render_isa.h"
-#include "amalgam/util/isa.h"
 
 namespace amalgam {
 namespace {

@@ -1,12 +1,13 @@
 // Differential and statistical tests of whole renders.
 
+#include "amalgam/render/render.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "amalgam/hierarchy/flatten.h"
 #include "amalgam/load/load_scene.h"
-#include "amalgam/render/render.h"
 
 namespace amalgam {
 namespace {
@@ -101,7 +102,8 @@ TEST(Render, CountsAddUp) {
   EXPECT_EQ(levels, c.total());
   EXPECT_EQ(c.rays[0], static_cast<std::uint64_t>(o.width) * o.height * o.spp);
   EXPECT_EQ(r.per_primary.count(), c.rays[0]);
-  EXPECT_NEAR(r.per_primary.mean() * static_cast<double>(c.rays[0]), static_cast<double>(c.total()), 1e-6 * c.total());
+  EXPECT_NEAR(r.per_primary.mean() * static_cast<double>(c.rays[0]), static_cast<double>(c.total()),
+              1e-6 * c.total());
 }
 
 // One amalgam of opacity a and colour C_a in front of the background, filling the view:

@@ -15,11 +15,11 @@
 #include <string>
 #include <type_traits>
 
-#include "amalgam/hierarchy/build/build.h"
-#include "amalgam/hierarchy/flatten.h"
 #include "amalgam/builtin/prisms.h"
 #include "amalgam/builtin/tube.h"
+#include "amalgam/hierarchy/build/build.h"
 #include "amalgam/hierarchy/explicit.h"
+#include "amalgam/hierarchy/flatten.h"
 #include "amalgam/hierarchy/instanced.h"
 #include "amalgam/hierarchy/wide.h"
 #include "amalgam/io/mesh_import.h"
@@ -310,7 +310,8 @@ TEST(SimdTraversal, TriangleLeavesMatchReference) {
 class SimdMesh : public ::testing::TestWithParam<int> {};
 
 TEST_P(SimdMesh, WusonMatchesReference) {
-  ASSERT_TRUE(std::filesystem::exists(kWuson)) << kWuson << " missing (assimp-testmodels, scripts/deps.sh)";
+  ASSERT_TRUE(std::filesystem::exists(kWuson))
+      << kWuson << " missing (assimp-testmodels, scripts/deps.sh)";
   const ImportedMesh m = import_mesh(kWuson);
   BuildConfig bc;
   bc.arity = GetParam();
@@ -352,7 +353,8 @@ TEST(SimdTraversal, BuiltinsMatchReference) {
 /// against the reference's generic path: rotated, non-uniformly scaled and mirrored instances
 /// of Wuson.ply, an identity instance, and a mesh with a box primitive.
 TEST(SimdTraversal, InstancedMatchesReference) {
-  ASSERT_TRUE(std::filesystem::exists(kWuson)) << kWuson << " missing (assimp-testmodels, scripts/deps.sh)";
+  ASSERT_TRUE(std::filesystem::exists(kWuson))
+      << kWuson << " missing (assimp-testmodels, scripts/deps.sh)";
   const ImportedMesh m = import_mesh(kWuson);
   BuildConfig bc;
   bc.parallel = false;

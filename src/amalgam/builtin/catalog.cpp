@@ -7,7 +7,9 @@ namespace {
 
 constexpr double kMaxIndex = 0x1.0p58;  // node indices are packed into 58 bits
 
-int read_lights(const Params& p) { return static_cast<int>(p.get_int("lights", 1, 1, 64)); }
+int read_lights(const Params& p) {
+  return static_cast<int>(p.get_int("lights", 1, 1, 64));
+}
 
 BuiltinScene make_tube(const std::string& name, const Params& p, TubeHierarchy::Mode mode) {
   TubeHierarchy::Config c;
@@ -16,8 +18,8 @@ BuiltinScene make_tube(const std::string& name, const Params& p, TubeHierarchy::
   c.depth = static_cast<int>(
       p.get_int("depth", mode == TubeHierarchy::Mode::kLine ? 6 : 10, 1, kMaxLevels - 2));
   if (std::pow(static_cast<double>(c.n), c.depth) >= kMaxIndex)
-    throw InputError(name + ": n^depth = " + std::to_string(c.n) + "^" +
-                     std::to_string(c.depth) + " exceeds 2^58 primitives");
+    throw InputError(name + ": n^depth = " + std::to_string(c.n) + "^" + std::to_string(c.depth) +
+                     " exceeds 2^58 primitives");
   if (mode == TubeHierarchy::Mode::kLine) {
     c.alpha = p.get_double("alpha", 0.0, 0.0, 1.0);
   } else {
@@ -32,7 +34,7 @@ BuiltinScene make_tube(const std::string& name, const Params& p, TubeHierarchy::
 }
 
 BuiltinScene make_prisms(const std::string& name, const Params& p, int default_depth,
-                        const std::string& default_view) {
+                         const std::string& default_view) {
   PrismsHierarchy::Config c;
   c.split = static_cast<int>(p.get_int("split", 2, 2, 4));
   c.depth = static_cast<int>(p.get_int("depth", default_depth, 1, 40));
@@ -65,7 +67,8 @@ const std::vector<BuiltinDoc>& builtin_docs() {
       {"prisms",
        "The paper's Figure 2: nested rectangular-prism amalgams, split^3 children each; "
        "rays orthogonal to a face meet split children per amalgam.",
-       {"split (default 2, 2..4): children per axis", "depth (default 6): amalgam levels 0..depth-1; primitives on level depth",
+       {"split (default 2, 2..4): children per axis",
+        "depth (default 6): amalgam levels 0..depth-1; primitives on level depth",
         "leaf (default 2): box primitives in each bottom amalgam, stacked along z",
         "fill (default 0.8): primitive size relative to its cell; amalgam opacity = fill^2",
         "view (default front): front (down -z, centre ray orthogonal to a face) or corner",
@@ -75,8 +78,7 @@ const std::vector<BuiltinDoc>& builtin_docs() {
        "a level-l node is passed without a hit with probability exp(-p / n^l).",
        {"n (default 2)", "depth (default 10): l_max",
         "p (default 64): expected hits along the ray through the whole scene",
-        "seed (default 0): which realisation of the process",
-        "lights (default 1, 1..64)"}},
+        "seed (default 0): which realisation of the process", "lights (default 1, 1..64)"}},
       {"demo",
        "The demo: builtin:prisms seen from a corner, 9 levels (33.5 million primitives); with "
        "--footprint the far amalgams are rendered as primitives.",

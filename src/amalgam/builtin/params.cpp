@@ -25,8 +25,8 @@ std::int64_t Params::get_int(const std::string& key, std::int64_t def, std::int6
     throw InputError(scene_ + ": --set " + key + "=" + s + ": expected an integer");
   if (v < lo || v > hi) {
     std::ostringstream m;
-    m << scene_ << ": --set " << key << "=" << s << ": expected an integer in [" << lo << ", "
-      << hi << "]";
+    m << scene_ << ": --set " << key << "=" << s << ": expected an integer in [" << lo << ", " << hi
+      << "]";
     throw InputError(m.str());
   }
   return v;

@@ -64,8 +64,7 @@ class TubeHierarchy {
   /// True when primitive k lies on the axis (is hit by the default ray).
   bool on_axis(PrimId k) const;
   Vec3 prim_centre(PrimId k) const {
-    return {static_cast<float>(x0_ + static_cast<double>(k) + 0.5), on_axis(k) ? 0.0f : 0.3f,
-            0.0f};
+    return {static_cast<float>(x0_ + static_cast<double>(k) + 0.5), on_axis(k) ? 0.0f : 0.3f, 0.0f};
   }
   const Config& config() const { return c_; }
   /// Number of primitives, n^l_max.

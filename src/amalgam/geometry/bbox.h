@@ -19,8 +19,7 @@ struct Bbox {
   /// Length of the diagonal: the box's size for level-of-detail decisions.
   float diagonal() const { return length(extent()); }
   constexpr bool contains(Vec3 p) const {
-    return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z &&
-           p.z <= hi.z;
+    return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
   }
   friend constexpr bool operator==(const Bbox&, const Bbox&) = default;
 };

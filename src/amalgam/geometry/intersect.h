@@ -89,9 +89,8 @@ struct TriangleCandidate {
 /// direction shrinks: a ray of direction length 1e-15 would reject every hit). A hit at t at or
 /// below the bound may lie behind the ray's origin: a shadow ray leaving a triangle whose
 /// point error is zero along its normal (a plane at coordinate 0) would otherwise meet it again.
-inline float triangle_t_error(float ax, float ay, float bx, float by, float cx, float cy,
-                              float az, float bz, float cz, float sz, float u, float v,
-                              float w, float det) {
+inline float triangle_t_error(float ax, float ay, float bx, float by, float cx, float cy, float az,
+                              float bz, float cz, float sz, float u, float v, float w, float det) {
   const float max_x = std::max(std::max(std::fabs(ax), std::fabs(bx)), std::fabs(cx));
   const float max_y = std::max(std::max(std::fabs(ay), std::fabs(by)), std::fabs(cy));
   const float max_z = std::max(std::max(std::fabs(az), std::fabs(bz)), std::fabs(cz));
@@ -128,8 +127,7 @@ inline bool triangle_test(const Ray& ray, const TrianglePre& p, Vec3 a, Vec3 b, 
   const float az = p.sz * A[p.kz], bz = p.sz * B[p.kz], cz = p.sz * C[p.kz];
   const float t = (u * az + v * bz + w * cz) / det;
   if (!(t >= ray.tmin && t <= ray.tmax)) return false;
-  if (t <= triangle_t_error(ax, ay, bx, by, cx, cy, A[p.kz], B[p.kz], C[p.kz], p.sz, u, v, w,
-                            det))
+  if (t <= triangle_t_error(ax, ay, bx, by, cx, cy, A[p.kz], B[p.kz], C[p.kz], p.sz, u, v, w, det))
     return false;
   out = {t, u, v, w, det};
   return true;

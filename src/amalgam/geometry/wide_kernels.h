@@ -215,8 +215,8 @@ inline unsigned triangle_test4(const TrianglePack4& p, const WideRay& r, float t
   const __m128 bad = _mm_or_ps(mixed, _mm_cmpeq_ps(det, zero));
   // t = (u az + v bz + w cz) / det with az = sz A[kz].
   const __m128 zs[3] = {_mm_mul_ps(sz, Z[0]), _mm_mul_ps(sz, Z[1]), _mm_mul_ps(sz, Z[2])};
-  const __m128 num = _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, zs[0]), _mm_mul_ps(v, zs[1])),
-                                _mm_mul_ps(w, zs[2]));
+  const __m128 num =
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, zs[0]), _mm_mul_ps(v, zs[1])), _mm_mul_ps(w, zs[2]));
   const __m128 t = _mm_div_ps(num, det);
   // !(t >= tmin && t <= tmax) rejects: ordered compares, so a NaN t is rejected as well.
   const __m128 in =

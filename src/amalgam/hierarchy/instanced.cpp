@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-
 namespace amalgam {
 
 namespace {
@@ -30,7 +29,7 @@ Bbox InstancedHierarchy::world_box(const InstanceData& in, const Bbox& b) {
 }
 
 InstancedHierarchy::InstanceData InstancedHierarchy::make_instance(const Instance& inst,
-                                                                  const ExplicitHierarchy& mesh) {
+                                                                   const ExplicitHierarchy& mesh) {
   InstanceData d;
   d.to_world = inst.to_world;
   d.to_object = inst.to_world.inverse();

@@ -7,7 +7,6 @@
 #include <string_view>
 
 #include "amalgam/math/random.h"
-
 #include "amalgam/util/atomic_file.h"
 #include "amalgam/util/error.h"
 
@@ -98,7 +97,8 @@ FilmState read_checkpoint(const std::string& path, const std::string& fingerprin
   const std::size_t pixels = static_cast<std::size_t>(st.width) * st.height;
   st.sum.resize(pixels);
   st.tests.resize(pixels);
-  in.read(reinterpret_cast<char*>(st.sum.data()), static_cast<std::streamsize>(pixels * sizeof(Vec3)));
+  in.read(reinterpret_cast<char*>(st.sum.data()),
+          static_cast<std::streamsize>(pixels * sizeof(Vec3)));
   in.read(reinterpret_cast<char*>(st.tests.data()),
           static_cast<std::streamsize>(pixels * sizeof(std::uint64_t)));
   get(in, st.counters);

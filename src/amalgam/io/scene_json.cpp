@@ -4,16 +4,16 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
-#include <iomanip>
 #include <sstream>
 
-#include "amalgam/io/json_reader.h"
 #include "amalgam/hierarchy/build/build.h"
+#include "amalgam/io/json_reader.h"
 #include "amalgam/io/mesh_import.h"
 #include "amalgam/io/scene_json_parts.h"
 #include "amalgam/math/transform.h"

@@ -32,13 +32,10 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
                 {"bounding_volume", c.tests_of(ObjectKind::kBoundingVolume)},
                 {"amalgam", c.tests_of(ObjectKind::kAmalgam)},
                 {"by_level", by_level}};
-  j["per_primary_ray"] = {{"mean", d.mean()},
-                          {"p50", d.quantile(0.5)},
-                          {"p99", d.quantile(0.99)},
-                          {"max", d.max()}};
-  j["time_s"] = {{"load", scene.load_seconds},
-                 {"build", scene.build_seconds},
-                 {"render", render_seconds}};
+  j["per_primary_ray"] = {
+      {"mean", d.mean()}, {"p50", d.quantile(0.5)}, {"p99", d.quantile(0.99)}, {"max", d.max()}};
+  j["time_s"] = {
+      {"load", scene.load_seconds}, {"build", scene.build_seconds}, {"render", render_seconds}};
   return j;
 }
 

@@ -3,8 +3,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "amalgam/render/options.h"
 #include "amalgam/render/loaded_scene.h"
+#include "amalgam/render/options.h"
 #include "amalgam/stats/counters.h"
 #include "amalgam/stats/distribution.h"
 

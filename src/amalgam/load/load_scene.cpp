@@ -65,7 +65,7 @@ LoadedScene load_scene(const std::string& spec, const Params& params,
   const bool exists = std::filesystem::exists(spec, ec);
   if (ec) throw InputError(spec + ": " + ec.message());  // e.g. a symbolic link loop
   if (!exists) throw InputError(spec + ": no such file");
-  params.check_all_used();       // --set configures builtin scenes only
+  params.check_all_used();               // --set configures builtin scenes only
   return load_scene_path(spec, config);  // .json or mesh; times its own load and build
 }
 

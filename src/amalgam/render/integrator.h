@@ -26,8 +26,8 @@ struct SampleResult {
 /// `Tracer` finds hits: `intersect(ray, key, translucent*) -> TraceHit` and
 /// `transmittance(ray, key) -> float`. It is amalgam's Traversal; the benchmarks substitute
 /// Intel Embree (bench/field_bench.cpp) to render the same image with another ray tracer.
-template <Hierarchy H, class Lod, class Opacity, class Order = SortedOrder,
-          class Stats = Counters, class Tracer = Traversal<H, Lod, Opacity, Order, Stats>>
+template <Hierarchy H, class Lod, class Opacity, class Order = SortedOrder, class Stats = Counters,
+          class Tracer = Traversal<H, Lod, Opacity, Order, Stats>>
 class Integrator {
  public:
   Integrator(const H& h, const Environment& env, const Lod& lod, Stats& counters)
@@ -39,8 +39,7 @@ class Integrator {
   SampleResult li(const Ray& primary, std::uint64_t key) {
     translucent_.clear();
     const TraceHit hit =
-        trav_.intersect(primary, hash_combine(key, 0),
-                        Opacity::kBlends ? &translucent_ : nullptr);
+        trav_.intersect(primary, hash_combine(key, 0), Opacity::kBlends ? &translucent_ : nullptr);
     std::uint64_t shadow_stream = 1;
     Vec3 colour{};
     float through = 1.0f;

@@ -13,9 +13,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "amalgam/util/isa.h"
 #include "amalgam/math/random.h"
 #include "amalgam/render/render.h"
+#include "amalgam/util/isa.h"
 
 namespace amalgam {
 AMALGAM_ISA_BEGIN

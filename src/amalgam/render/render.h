@@ -5,8 +5,8 @@
 #include <functional>
 #include <vector>
 
-#include "amalgam/render/options.h"
 #include "amalgam/render/loaded_scene.h"
+#include "amalgam/render/options.h"
 #include "amalgam/stats/counters.h"
 #include "amalgam/stats/distribution.h"
 #include "amalgam/traverse/hit.h"
@@ -17,9 +17,9 @@ namespace amalgam {
 struct RenderOutput {
   int width = 0, height = 0, spp = 0;  ///< spp: samples per pixel the image holds
   bool interrupted = false;            ///< stopped by RenderControl::cancel before options.spp
-  std::vector<Vec3> image;   ///< linear RGB, mean over samples, row-major from the top
-  std::vector<double> cost;  ///< intersection tests per pixel (all rays of its samples) / spp
-  Counters counters;         ///< exact totals, merged over threads
+  std::vector<Vec3> image;             ///< linear RGB, mean over samples, row-major from the top
+  std::vector<double> cost;      ///< intersection tests per pixel (all rays of its samples) / spp
+  Counters counters;             ///< exact totals, merged over threads
   CostDistribution per_primary;  ///< tests per primary ray including its shadow rays
   double seconds = 0.0;
 };

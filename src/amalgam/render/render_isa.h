@@ -17,7 +17,6 @@ bool render_passes_avx2(const LoadedScene& scene, const RenderOptions& o, FilmSt
 /// Traces one primary sample along `ray` into `out` (counters, hit, colour).
 void trace_portable(const LoadedScene& scene, const RenderOptions& o, const Ray& ray,
                     TraceOutput& out);
-void trace_avx2(const LoadedScene& scene, const RenderOptions& o, const Ray& ray,
-                TraceOutput& out);
+void trace_avx2(const LoadedScene& scene, const RenderOptions& o, const Ray& ray, TraceOutput& out);
 
 }  // namespace amalgam::detail

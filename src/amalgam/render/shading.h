@@ -3,8 +3,8 @@
 
 #include <numbers>
 
-#include "amalgam/util/isa.h"
 #include "amalgam/scene/scene.h"
+#include "amalgam/util/isa.h"
 
 namespace amalgam {
 AMALGAM_ISA_BEGIN
@@ -17,8 +17,8 @@ inline Vec3 brdf(const Surface& s, Vec3 n, Vec3 wi, Vec3 wo) {
   if (s.reflectance > 0.0f) {
     const Vec3 h = normalize(wi + wo);
     const float c = std::max(0.0f, dot(n, h));
-    const float spec = s.reflectance * (s.shininess + 8.0f) * (inv_pi / 8.0f) *
-                       std::pow(c, s.shininess);
+    const float spec =
+        s.reflectance * (s.shininess + 8.0f) * (inv_pi / 8.0f) * std::pow(c, s.shininess);
     f += Vec3{spec, spec, spec};
   }
   return f;

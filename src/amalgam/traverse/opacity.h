@@ -32,7 +32,7 @@ struct StochasticOpacity {
   static constexpr bool kBlends = false;
   AmalgamEffect effect(float a, std::uint64_t ray_key, NodeId id) const {
     return to_unit_float(hash_combine(ray_key, id)) < a ? AmalgamEffect::kStop
-                                                       : AmalgamEffect::kPass;
+                                                        : AmalgamEffect::kPass;
   }
 };
 

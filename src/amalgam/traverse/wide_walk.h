@@ -136,8 +136,7 @@ class WideWalk {
     for (; count - c0 > kWideLanes; c0 += 2 * kWideLanes, blk += 2) {
       alignas(32) float t[2 * kWideLanes];
       const int m = std::min(count - c0, 2 * kWideLanes);
-      collect(intersect_wide8<kZeroAxes>(blk[0], blk[1], wr, s.ray.tmin, s.ray.tmax, m, t), t,
-              c0);
+      collect(intersect_wide8<kZeroAxes>(blk[0], blk[1], wr, s.ray.tmin, s.ray.tmax, m, t), t, c0);
     }
 #endif
     for (; c0 < count; c0 += kWideLanes, ++blk) {
@@ -152,8 +151,8 @@ class WideWalk {
   /// hits before it, so of the lanes hit (all tested against the same tmax) a lane is taken in
   /// leaf order when its t is still <= tmax (ties: the later one, as there); a shadow ray stops
   /// at the first hit in leaf order, having tested the triangles up to and including it.
-  static void leaf_triangles(State& s, const WideNodes& w, const WideRay& wr,
-                             const WideHeader& hd, int level) {
+  static void leaf_triangles(State& s, const WideNodes& w, const WideRay& wr, const WideHeader& hd,
+                             int level) {
     const TrianglePack4* pack = w.tris.data() + hd.block;
     const int count = hd.count;
     for (int c0 = 0; c0 < count; c0 += kWideLanes, ++pack) {

@@ -1,20 +1,19 @@
 #include "amalgam/util/atomic_file.h"
 
-#include "amalgam/util/fd_io.h"
-
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <climits>
-#include <cstring>
-
 #include <atomic>
 #include <cerrno>
+#include <climits>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <system_error>
+
+#include "amalgam/util/fd_io.h"
 
 namespace amalgam {
 namespace {
@@ -31,7 +30,6 @@ std::atomic<unsigned long> g_counter{0};  ///< tells apart the temporaries of on
 /// published by `g_temp_active` after it is filled.
 char g_temp_path[PATH_MAX];
 std::atomic<int> g_temp_active{0};
-
 
 /// Makes a completed rename durable (best effort: a directory that cannot be opened or synced
 /// does not fail a write whose data is already safely on disk).
@@ -70,8 +68,10 @@ OutputTarget resolve_output(const std::string& path) {
   }
   const fs::path parent = p.parent_path().empty() ? fs::path(".") : p.parent_path();
   const fs::file_status ps = fs::status(parent, ec);
-  if (!fs::exists(ps)) throw InputError(path + ": the directory " + parent.string() + " does not exist");
-  if (!fs::is_directory(ps)) throw InputError(path + ": " + parent.string() + " is not a directory");
+  if (!fs::exists(ps))
+    throw InputError(path + ": the directory " + parent.string() + " does not exist");
+  if (!fs::is_directory(ps))
+    throw InputError(path + ": " + parent.string() + " is not a directory");
   t.kind = OutputTarget::Kind::kFile;
   return t;
 }

@@ -93,9 +93,10 @@ class AtomicFile {
 /// Writes `path` atomically: `body` writes a temporary file in the same directory (so the
 /// rename never crosses file systems), which is then flushed, fsynced and renamed onto `path`
 /// (replacing an existing regular file, keeping its permission bits); a special target is
-/// written through (see the file comment). On any failure, of the body or of the file, the temporary is
-/// removed and an `Error` (RuntimeError or a kind derived from it) is thrown whose what() is
-/// one line, "<path>: <reason>"; exceptions thrown by `body` give their what() as the reason.
+/// written through (see the file comment). On any failure, of the body or of the file, the
+/// temporary is removed and an `Error` (RuntimeError or a kind derived from it) is thrown whose
+/// what() is one line, "<path>: <reason>"; exceptions thrown by `body` give their what() as the
+/// reason.
 template <class Error = RuntimeError>
 void write_atomically(const std::string& path, const std::function<void(AtomicFile&)>& body) {
   static_assert(std::is_base_of_v<RuntimeError, Error>, "a failed write is a RuntimeError");

@@ -11,13 +11,14 @@
 #include "amalgam/util/error.h"
 
 namespace amalgam::detail {
-[[noreturn]] void check_failed(const char* cond, const char* file, int line, const std::string& what);
+[[noreturn]] void check_failed(const char* cond, const char* file, int line,
+                               const std::string& what);
 }  // namespace amalgam::detail
 
-#define AMALGAM_CHECK(cond, what)                                                    \
-  do {                                                                               \
-    if (!(cond)) [[unlikely]]                                                        \
-      ::amalgam::detail::check_failed(#cond, __FILE__, __LINE__, (what));            \
+#define AMALGAM_CHECK(cond, what)                                         \
+  do {                                                                    \
+    if (!(cond)) [[unlikely]]                                             \
+      ::amalgam::detail::check_failed(#cond, __FILE__, __LINE__, (what)); \
   } while (false)
 
 namespace amalgam {

@@ -31,17 +31,18 @@ Simd active_simd() {
     if (v == "portable") return Simd::kPortable;
     if (v == "avx2") {
       if (!avx2)
-        throw InputError(std::string("AMALGAM_SIMD=avx2: ") +
-                         (simd_avx2_built() ? "this CPU does not support AVX2"
-                                            : "this build has no AVX2 code"));
+        throw InputError(
+            std::string("AMALGAM_SIMD=avx2: ") +
+            (simd_avx2_built() ? "this CPU does not support AVX2" : "this build has no AVX2 code"));
       return Simd::kAvx2;
     }
-    throw InputError("AMALGAM_SIMD=" + one_line(v, 40) +
-                     ": expected portable, avx2 or auto");
+    throw InputError("AMALGAM_SIMD=" + one_line(v, 40) + ": expected portable, avx2 or auto");
   }();
   return chosen;
 }
 
-std::string simd_name(Simd s) { return s == Simd::kAvx2 ? "avx2" : "portable"; }
+std::string simd_name(Simd s) {
+  return s == Simd::kAvx2 ? "avx2" : "portable";
+}
 
 }  // namespace amalgam

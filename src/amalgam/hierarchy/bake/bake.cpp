@@ -145,7 +145,8 @@ void bake(ExplicitHierarchy& h, const BakeConfig& config) {
       r = bake_exact(h, static_cast<std::uint32_t>(i), config, orientation);
     } else {
       BakeChild kids[kMaxChildren];
-      AMALGAM_CHECK(node.count <= kMaxChildren, "bake: a node with more than kMaxChildren children");
+      AMALGAM_CHECK(node.count <= kMaxChildren,
+                    "bake: a node with more than kMaxChildren children");
       const int k = node.count;
       for (int c = 0; c < k; ++c)
         kids[c] = {h.nodes[node.first + c].bounds, h.appearances[node.first + c],

@@ -28,7 +28,8 @@ SahConfig sah_config(const BuildConfig& config) {
 std::vector<ExplicitNode> explicit_nodes(const SahTree& t) {
   std::vector<ExplicitNode> nodes(t.nodes.size());
   for (std::size_t i = 0; i < t.nodes.size(); ++i) {
-    AMALGAM_CHECK(t.nodes[i].count <= kMaxChildren, "SAH node with more than kMaxChildren children");
+    AMALGAM_CHECK(t.nodes[i].count <= kMaxChildren,
+                  "SAH node with more than kMaxChildren children");
     nodes[i] = {t.nodes[i].bounds, t.nodes[i].first, t.nodes[i].count, t.nodes[i].leaf};
   }
   return nodes;

@@ -20,11 +20,11 @@ namespace amalgam {
 /// are overestimated, by up to 40 % (the allocator reuses the memory of the process), which
 /// errs on the safe side.
 struct MemoryModel {
-  static constexpr std::uint64_t kProcess = 8u << 20;       ///< the process before any scene
-  static constexpr std::uint64_t kSceneFile = 8u << 20;     ///< reading a scene file or mesh
-  static constexpr std::uint64_t kPerTriangle = 250;        ///< explicit hierarchy, at its peak
-  static constexpr std::uint64_t kPerInstance = 320;        ///< instanced hierarchy
-  static constexpr std::uint64_t kPerPixel = 44;            ///< film: sums, tests, image, cost
+  static constexpr std::uint64_t kProcess = 8u << 20;    ///< the process before any scene
+  static constexpr std::uint64_t kSceneFile = 8u << 20;  ///< reading a scene file or mesh
+  static constexpr std::uint64_t kPerTriangle = 250;     ///< explicit hierarchy, at its peak
+  static constexpr std::uint64_t kPerInstance = 320;     ///< instanced hierarchy
+  static constexpr std::uint64_t kPerPixel = 44;         ///< film: sums, tests, image, cost
   /// Bytes a scene file of `triangles` triangles built explicitly (loose or expanded), plus
   /// `instances` placements of instanced meshes of `instanced_triangles` in all, takes.
   static constexpr std::uint64_t scene(std::uint64_t triangles, std::uint64_t instanced_triangles,
