@@ -14,6 +14,7 @@
 #include "amalgam/io/checkpoint.h"
 #include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
+#include "amalgam/io/scene_json.h"
 #include "amalgam/io/stats_json.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
@@ -101,15 +102,6 @@ std::uint64_t film_bytes(const RenderOptions& o) {
   return MemoryModel::kProcess + pixels * MemoryModel::kPerPixel;
 }
 
-std::string human_bytes(double b) {
-  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
-  int u = 0;
-  while (b >= 1024 && u < 4) b /= 1024, ++u;
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(u ? 1 : 0) << b << " " << units[u];
-  return s.str();
-}
-
 /// A one-line progress bar with ETA on stderr, shown only on a terminal, after one second.
 class Progress {
  public:
@@ -166,13 +158,13 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   const std::uint64_t film = film_bytes(o);
   if (film > limit)
     throw InputError("--width " + std::to_string(o.width) + " --height " +
-                     std::to_string(o.height) + ": the film needs " + human_bytes(film) +
-                     ", more than --max-memory " + human_bytes(limit));
+                     std::to_string(o.height) + ": the film needs " + format_bytes(film) +
+                     ", more than --max-memory " + format_bytes(limit));
   set_activity("loading and building " + common.scene);
   SceneFileConfig budget;  // checked before the scene is built (MemoryModel)
   budget.max_bytes = limit - film;
-  budget.limit_name = "--max-memory " + human_bytes(static_cast<double>(limit)) + " less " +
-                      human_bytes(static_cast<double>(film)) + " for the film";
+  budget.limit_name = "--max-memory " + format_bytes(static_cast<double>(limit)) + " less " +
+                      format_bytes(static_cast<double>(film)) + " for the film";
   const LoadedScene scene = load_scene(common.scene, common.params(), budget);
   check_options(scene, o);
 
