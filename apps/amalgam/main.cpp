@@ -6,8 +6,11 @@
 #include <exception>
 #include <iostream>
 #include <new>
+#include <string>
 
+#include "amalgam/analysis/experiments.h"
 #include "amalgam/util/error.h"
+#include "amalgam/util/version.h"
 #include "common.h"
 
 namespace {
@@ -37,6 +40,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "amalgam: a ray tracer with renderable bounding volumes (amalgams), after "
       "Thompson & Fussell, 'Time Costs of Ray Tracing with Amalgams' (1991)"};
+  app.set_version_flag("--version", std::string("amalgam ") + version());
   app.require_subcommand(1);
 
   cli::CommonOptions render_opts;
@@ -92,7 +96,11 @@ int main(int argc, char** argv) {
   int exp_threads = 0;
   CLI::App* experiment = app.add_subcommand(
       "experiment", "reproduce the paper's analyses as measured sweeps (NAME or all)");
-  experiment->add_option("name", exp_name, "experiment name, or all")->required();
+  std::string exp_names;
+  for (const std::string& n : experiments::names())
+    exp_names += (exp_names.empty() ? "" : ", ") + n;
+  experiment->add_option("name", exp_name, "experiment name, or all; one of: " + exp_names)
+      ->required();
   experiment->add_option("--out", exp_out, "output directory")->required();
   experiment->add_flag("--quick", exp_quick, "small sizes (as the tests use)");
   experiment->add_option("--threads", exp_threads, "worker threads (default: all cores)");
@@ -111,6 +119,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::cerr << "amalgam: " << e.what() << " (see 'amalgam --help')\n";

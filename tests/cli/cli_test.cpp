@@ -244,6 +244,14 @@ TEST(Cli, HelpForEverySubcommand) {
     EXPECT_EQ(r.status, 0) << sub;
     EXPECT_NE(r.out.find("Usage"), std::string::npos) << sub;
   }
+  const CliRun v = run("--version");
+  EXPECT_EQ(v.status, 0);
+  EXPECT_EQ(v.out.rfind("amalgam ", 0), 0u) << v.out;
+  EXPECT_EQ(std::count(v.out.begin(), v.out.end(), '\n'), 1) << v.out;
+  // experiment --help names every experiment, so a user need not read the docs to pick one.
+  const CliRun e = run("experiment --help");
+  for (const char* name : {"worst-traditional", "expected", "noise", "linear-cost"})
+    EXPECT_NE(e.out.find(name), std::string::npos) << name;
   const CliRun s = run("scenes");
   EXPECT_EQ(s.status, 0);
   for (const char* name : {"builtin:line", "builtin:prisms", "builtin:poisson", "builtin:demo"})
