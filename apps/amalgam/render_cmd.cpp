@@ -20,6 +20,7 @@
 #include "amalgam/render/render.h"
 #include "amalgam/util/atomic_file.h"
 #include "common.h"
+#include "progress.h"
 
 namespace amalgam::cli {
 
@@ -102,33 +103,6 @@ std::uint64_t film_bytes(const RenderOptions& o) {
   return MemoryModel::kProcess + pixels * MemoryModel::kPerPixel;
 }
 
-/// A one-line progress bar with ETA on stderr, shown only on a terminal, after one second.
-class Progress {
- public:
-  Progress(int total, bool enabled) : total_(total), enabled_(enabled && isatty(2)) {}
-  void update(int done) {
-    if (!enabled_) return;
-    const double t = std::chrono::duration<double>(clock::now() - start_).count();
-    if (t < 1.0 || done <= 0) return;
-    const double eta = t / done * (total_ - done);
-    const int width = 30, fill = static_cast<int>(width * static_cast<double>(done) / total_);
-    std::fprintf(stderr, "\r[%s%s] %3d%% %d/%d spp, %.1f s, ETA %.1f s ",
-                 std::string(fill, '#').c_str(), std::string(width - fill, ' ').c_str(),
-                 100 * done / total_, done, total_, t, eta);
-    shown_ = true;
-  }
-  ~Progress() {
-    if (shown_) std::fprintf(stderr, "\n");
-  }
-
- private:
-  using clock = std::chrono::steady_clock;
-  int total_;
-  bool enabled_;
-  bool shown_ = false;
-  clock::time_point start_ = clock::now();
-};
-
 void write_cost_image(const std::string& path, const RenderOutput& r) {
   const std::string ext = path.substr(path.find_last_of('.') + 1);
   if (ext == "png" || ext == "PNG") {
@@ -161,11 +135,17 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
                      std::to_string(o.height) + ": the film needs " + format_bytes(film) +
                      ", more than --max-memory " + format_bytes(limit));
   set_activity("loading and building " + common.scene);
+  PhaseStatus status(!extra.quiet);
   SceneFileConfig budget;  // checked before the scene is built (MemoryModel)
   budget.max_bytes = limit - film;
   budget.limit_name = "--max-memory " + format_bytes(static_cast<double>(limit)) + " less " +
                       format_bytes(static_cast<double>(film)) + " for the film";
+  budget.on_phase = [&](const std::string& what) {
+    set_activity(what);
+    status.phase(what);
+  };
   const LoadedScene scene = load_scene(common.scene, common.params(), budget);
+  status.stop();
   check_options(scene, o);
 
   const std::string fp = fingerprint(common, scene);
@@ -199,6 +179,7 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   };
   set_activity("rendering " + common.scene);
   RenderOutput r = render(scene, o, &state, control);
+  progress.finish();
   set_activity("writing the outputs of " + common.scene);
   // The work is done: writing its results wins over further signals (on_signal).
   g_finishing.store(true);

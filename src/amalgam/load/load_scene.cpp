@@ -44,12 +44,14 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
 LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
+  if (config.on_phase) config.on_phase("reading " + path);
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   SceneDescription d = ext == ".json" ? read_scene_json(path, config) : mesh_scene(path, config);
   const auto t1 = Clock::now();
   Environment env = std::move(d.env);
+  if (config.on_phase) config.on_phase("building and baking " + path);
   AnyHierarchy h = build_hierarchy(std::move(d));
   const auto t2 = Clock::now();
   LoadedScene s{path, std::move(h), std::move(env)};
