@@ -22,13 +22,18 @@ struct CommonOptions {
   float footprint = 1.0f;
   std::string seed = "0";
   int threads = 0;
+  std::string tracer = "amalgam";
   RenderOptions options;
   CLI::Option* level_option = nullptr;
   CLI::Option* footprint_option = nullptr;
+  CLI::Option* renderer_option = nullptr;
+  CLI::Option* opacity_option = nullptr;
+  CLI::Option* order_option = nullptr;
 
   /// Registers SCENE, --set and the renderer options of CONTRACT.md on `app`.
   void add_to(CLI::App& app);
-  /// Converts the parsed text into `options`; throws InputError on bad values.
+  /// Converts the parsed text into `options`; throws InputError on bad values, and on options
+  /// --tracer embree cannot honour (it renders at full detail) or a build without Embree.
   void finish();
   Params params() const;
 };

@@ -66,6 +66,23 @@ TEST(Cli, TraceLineTraditionalIsTheWorstCase) {
   EXPECT_TRUE(j["level"].is_null());
 }
 
+TEST(Cli, TraceFootprintIsThatOfAPixelOfWidthByHeight) {
+  auto trace = [](const std::string& size) {
+    const CliRun r = run("trace builtin:prisms" + size);
+    EXPECT_EQ(r.status, 0) << size;
+    return nlohmann::json::parse(r.out);
+  };
+  const auto by_default = trace(""), same = trace(" --width 512 --height 512");
+  EXPECT_EQ(by_default["tests"], same["tests"]);  // 512 x 512 is the default, as for render
+  EXPECT_EQ(by_default["hit"], same["hit"]);
+  // A pixel of a 16 x 16 image is wide: the ray stops at an amalgam above the primitives.
+  const auto coarse = trace(" --width 16 --height 16");
+  EXPECT_EQ(coarse["hit"]["object"]["kind"], "amalgam");
+  EXPECT_EQ(by_default["hit"]["object"]["kind"], "primitive");
+  EXPECT_LT(coarse["tests"]["total"].get<int>(), by_default["tests"]["total"].get<int>());
+  EXPECT_EQ(run("trace builtin:prisms --width 0").status, 2);
+}
+
 TEST(Cli, RenderWritesImageCostImageAndStats) {
   const fs::path d = temp_dir();
   const CliRun r =
