@@ -1,8 +1,14 @@
 #pragma once
-/// \file The stats JSON of CONTRACT.md ("renderer", "scene", "rays", "tests", ...).
+/// \file The stats JSON of CONTRACT.md ("renderer", "scene", "rays", "tests", ...), with the
+/// run's description (docs/outputs.md lists every key and its unit).
 
+#include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
 
+#include "amalgam/io/colormap.h"
 #include "amalgam/render/loaded_scene.h"
 #include "amalgam/render/options.h"
 #include "amalgam/stats/counters.h"
@@ -14,5 +20,19 @@ namespace amalgam {
 nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& options,
                           const Counters& counters, const CostDistribution& per_primary,
                           double render_seconds);
+
+/// What a whole render adds to its stats object.
+struct RunInfo {
+  std::vector<std::string> argv;  ///< the command line, as given
+  int width = 0, height = 0;
+  int spp = 0;      ///< samples per pixel the outputs hold
+  int threads = 0;  ///< worker threads used
+  std::uint64_t peak_memory_bytes = 0;
+  std::optional<LogRange> cost_range;  ///< the cost image's scale, when it has one
+};
+
+/// Adds "width", "height", "spp", "threads", "command_line", "peak_memory_bytes" and
+/// "cost_range" ({"min", "max", "scale": "log", "unit"}) to `j`.
+void add_run_info(nlohmann::json& j, const RunInfo& info);
 
 }  // namespace amalgam

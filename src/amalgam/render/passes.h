@@ -52,11 +52,7 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
   // Samples per pass: whole samples for every pixel, about 2^16 primary rays per pass so that
   // small images do not pay for many passes and large ones can stop quickly.
   const int per_pass = std::max(1, static_cast<int>(65536 / std::max<std::size_t>(pixels, 1)));
-  // More threads than the machine runs at once buys nothing (and makes oneTBB print a warning):
-  // at most its concurrency. The image does not depend on the thread count.
-  const int cores = tbb::this_task_arena::max_concurrency();
-  const int threads = o.threads > 0 ? std::min(o.threads, cores) : cores;
-  tbb::task_arena arena(threads);
+  tbb::task_arena arena(render_threads(o));
   std::vector<Vec3> pass_sum;
   std::vector<std::uint64_t> pass_tests;
   std::vector<PixelAov> pass_aov;

@@ -1,5 +1,7 @@
 #include "amalgam/render/render.h"
 
+#include <oneapi/tbb/task_arena.h>
+
 #include <algorithm>
 #include <chrono>
 #include <type_traits>
@@ -17,6 +19,13 @@ void check_options(const LoadedScene& scene, const RenderOptions& o) {
   if (!(o.footprint > 0.0f)) throw InputError("--footprint: expected a number > 0");
   if (o.width < 1 || o.height < 1 || o.spp < 1)
     throw InputError("--width, --height and --spp must be at least 1");
+}
+
+int render_threads(const RenderOptions& o) {
+  // More threads than the machine runs at once buys nothing (and makes oneTBB print a
+  // warning). The image does not depend on the thread count.
+  const int cores = tbb::this_task_arena::max_concurrency();
+  return o.threads > 0 ? std::min(o.threads, cores) : cores;
 }
 
 RenderOutput finish(const FilmState& st) {

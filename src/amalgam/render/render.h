@@ -92,6 +92,10 @@ struct TraceOutput {
 /// Traces one primary ray with its shadow rays (random stream hash(seed, 0, 0)).
 TraceOutput trace(const LoadedScene& scene, const RenderOptions& options, const Ray& ray);
 
+/// The worker threads a render with these options runs on: options.threads (0: all cores),
+/// at most the machine's concurrency.
+int render_threads(const RenderOptions& options);
+
 /// Throws InputError when options do not fit the scene (e.g. --level beyond l_max).
 void check_options(const LoadedScene& scene, const RenderOptions& options);
 

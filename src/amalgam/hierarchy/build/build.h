@@ -44,6 +44,7 @@ struct BuildConfig {
   int bins = 16;      ///< SAH bins per axis
   bool parallel = true;
   BakeConfig bake;
+  double* bake_seconds = nullptr;  ///< when set, the bakes' wall time is added to it
 };
 
 /// Builds a hierarchy over `prims` with a binned SAH, collapsed to `arity`-wide nodes, in
