@@ -319,7 +319,7 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   run.spp = r.spp;
   run.threads = render_threads(o);
   run.peak_memory_bytes = peak_memory_bytes();
-  if (!extra.cost_image.empty() && is_png_path(extra.cost_image)) run.cost_range = range;
+  run.cost_range = range;
   add_run_info(stats, run);
   const std::string json = stats.dump(2) + "\n";
   if (!extra.stats.empty()) attempt(extra.stats, [&] { write_file_atomic(extra.stats, json); });

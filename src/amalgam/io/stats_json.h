@@ -28,7 +28,9 @@ struct RunInfo {
   int spp = 0;      ///< samples per pixel the outputs hold
   int threads = 0;  ///< worker threads used
   std::uint64_t peak_memory_bytes = 0;
-  std::optional<LogRange> cost_range;  ///< the cost image's scale, when it has one
+  /// The cost PNG's scale (--cost-range, else the image's own range), also when no PNG is
+  /// written: the range to give another render's --cost-range to compare the two.
+  std::optional<LogRange> cost_range;
 };
 
 /// Adds "width", "height", "spp", "threads", "command_line", "peak_memory_bytes" and
