@@ -28,6 +28,7 @@ struct PixelAov {
   std::uint32_t amalgams = 0;    ///< samples whose primary ray ended at a rendered amalgam
   std::uint32_t primitives = 0;  ///< samples whose primary ray ended at a primitive
   std::uint32_t level_sum = 0;   ///< sum of the levels of those rendered amalgams
+  friend bool operator==(const PixelAov&, const PixelAov&) = default;
 };
 static_assert(sizeof(PixelAov) == 40, "PixelAov is stored in checkpoints as raw bytes");
 
