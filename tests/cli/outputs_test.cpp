@@ -17,6 +17,7 @@
 #include <ImfStringAttribute.h>
 #pragma GCC diagnostic pop
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -161,6 +162,32 @@ TEST(RenderOutputs, ExrHasEveryLayerInFloat32AndTheCostAddsUpToTheStats) {
   ASSERT_EQ(levels.size(), ch.at("level.Y").size());
   for (std::size_t i = 0; i < levels.size(); ++i)
     EXPECT_EQ(levels[i].x, ch.at("level.Y")[i]) << "pixel " << i;
+}
+
+// Totals above 2048 per pixel (where half floats round) are exact in the float32 cost layer.
+TEST(RenderOutputs, ExrCostIsExactBeyondHalfPrecision) {
+  const fs::path d = temp_dir() / "exact";
+  fs::create_directories(d);
+  ASSERT_EQ(amalgam("render builtin:prisms --set depth=5 --set view=corner --renderer "
+                    "traditional --width 4 --height 3 --spp 64 --quiet --out " +
+                    (d / "a.exr").string() + " --stats " + (d / "s.json").string())
+                .status,
+            0);
+  int w = 0, h = 0;
+  const auto ch = read_channels(d / "a.exr", w, h);
+  std::uint64_t sum = 0;
+  float top = 0;
+  int odd_above_2048 = 0;  // half floats hold only even integers in [2048, 4096)
+  for (float c : ch.at("cost.Y")) {
+    ASSERT_EQ(c, std::floor(c));
+    sum += static_cast<std::uint64_t>(c);
+    top = std::max(top, c);
+    odd_above_2048 += c > 2048 && static_cast<std::uint64_t>(c) % 2 == 1;
+  }
+  EXPECT_GT(top, 2048.0f) << "the test needs a pixel beyond half precision";
+  EXPECT_GT(odd_above_2048, 0) << "no total that half would have rounded";
+  const auto j = nlohmann::json::parse(slurp(d / "s.json"));
+  EXPECT_EQ(sum, j["tests"]["total"].get<std::uint64_t>());
 }
 
 TEST(RenderOutputs, PlainRgbReadersAndCompareSeeTheBeauty) {
