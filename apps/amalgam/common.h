@@ -62,6 +62,9 @@ Vec3 parse_vec3(const std::string& text, const std::string& option);
 /// The options of `render` beyond the shared ones.
 struct RenderExtras {
   std::string out, stats, cost_image, checkpoint;
+  std::string level_image;        ///< --level-image PATH
+  std::string cost_range;         ///< --cost-range MIN,MAX as given; empty: the image's own
+  std::vector<std::string> argv;  ///< the whole command line, for the stats and EXR header
   bool resume = false;
   bool quiet = false;
   std::string max_memory;          ///< as given (parse_bytes); empty: the machine's physical memory

@@ -1,5 +1,6 @@
-/// `amalgam compare A B`: image error metrics (RMSE, PSNR, SSIM, mean and max absolute error)
-/// and an optional false-colour error image.
+/// `amalgam compare A B`: image error metrics (RMSE, PSNR, SSIM, mean and max absolute error,
+/// relative MSE) and an optional false-colour error image. The text output prints the same keys
+/// as the JSON output, one "key value" per line.
 
 #include <cmath>
 #include <cstdio>
@@ -49,35 +50,38 @@ int run_compare(const CompareOptions& o) {
   if (!o.error_image.empty())
     write_image(o.error_image, wa, ha, false_colour(error_map(a, b), false, &vmax));
 
+  // One list of (key, value) for both outputs, so the text and JSON keys are the same.
+  nlohmann::ordered_json j;
+  j["a"] = o.a;
+  j["b"] = o.b;
+  j["width"] = wa;
+  j["height"] = ha;
+  j["rmse"] = c.rmse;
+  if (std::isinf(c.psnr))
+    j["psnr_db"] = "inf";  // JSON has no infinity
+  else
+    j["psnr_db"] = c.psnr;
+  j["ssim"] = c.ssim;
+  j["mean_abs_error"] = c.mean_abs;
+  j["max_abs_error"] = c.max_abs;
+  j["rel_mse"] = c.rel_mse;
+  if (!o.error_image.empty()) {
+    j["error_image"] = o.error_image;
+    j["error_image_max"] = vmax;
+  }
   if (o.json) {
-    nlohmann::json j;
-    j["a"] = o.a;
-    j["b"] = o.b;
-    j["width"] = wa;
-    j["height"] = ha;
-    j["rmse"] = c.rmse;
-    if (std::isinf(c.psnr))
-      j["psnr_db"] = "inf";  // JSON has no infinity
-    else
-      j["psnr_db"] = c.psnr;
-    j["ssim"] = c.ssim;
-    j["mean_abs_error"] = c.mean_abs;
-    j["max_abs_error"] = c.max_abs;
-    if (!o.error_image.empty()) {
-      j["error_image"] = o.error_image;
-      j["error_image_max"] = vmax;
-    }
     std::cout << j.dump(2) << "\n";
-  } else {
-    std::cout << "size      " << wa << "x" << ha << "\n"
-              << "rmse      " << format_number(c.rmse) << "\n"
-              << "psnr_db   " << format_number(c.psnr) << "\n"
-              << "ssim      " << format_number(c.ssim) << "\n"
-              << "mean_abs  " << format_number(c.mean_abs) << "\n"
-              << "max_abs   " << format_number(c.max_abs) << "\n";
-    if (!o.error_image.empty())
-      std::cout << "error image " << o.error_image
-                << " (viridis, per-pixel RMS error, top = " << format_number(vmax) << ")\n";
+    return 0;
+  }
+  for (const auto& [key, value] : j.items()) {
+    std::cout << key << std::string(key.size() < 16 ? 16 - key.size() : 1, ' ');
+    if (value.is_string())
+      std::cout << value.get<std::string>();
+    else if (value.is_number_integer())
+      std::cout << value.get<long long>();
+    else
+      std::cout << format_number(value.get<double>());
+    std::cout << "\n";
   }
   return 0;
 }

@@ -51,6 +51,12 @@ int main(int argc, char** argv) {
   render->add_option("--stats", extras.stats, "write the stats JSON to FILE, or - for stdout");
   render->add_option("--cost-image", extras.cost_image,
                      "write intersection tests per pixel: false colour (.png) or raw (.exr/.pfm)");
+  render->add_option("--cost-range", extras.cost_range,
+                     "MIN,MAX: the log scale of the cost PNG, in tests per primary sample "
+                     "(default: the image's own range)");
+  render->add_option("--level-image", extras.level_image,
+                     "write the rendered level per pixel: colour-coded (.png) or raw (.pfm/.exr)");
+  extras.argv.assign(argv, argv + argc);
   render->add_option("--width", render_opts.options.width, "image width (default 512)")
       ->check(cli::positive_int());
   render->add_option("--height", render_opts.options.height, "image height (default 512)")
@@ -114,7 +120,8 @@ int main(int argc, char** argv) {
 
   cli::CompareOptions cmp;
   CLI::App* compare = app.add_subcommand(
-      "compare", "compare two images: RMSE, PSNR, SSIM on luminance, mean and max error");
+      "compare",
+      "compare two images: RMSE, PSNR, SSIM on luminance, mean and max error, relative MSE");
   compare->add_option("a", cmp.a, "first image (.png, .pfm or .exr)")->required();
   compare->add_option("b", cmp.b, "second image, e.g. the reference (same size)")->required();
   compare->add_option("--error-image", cmp.error_image,

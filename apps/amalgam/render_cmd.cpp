@@ -1,19 +1,23 @@
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "amalgam/hierarchy/build/build.h"
 #include "amalgam/io/checkpoint.h"
 #include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
+#include "amalgam/io/render_outputs.h"
 #include "amalgam/io/scene_json.h"
 #include "amalgam/io/stats_json.h"
 #include "amalgam/load/load_scene.h"
@@ -22,6 +26,7 @@
 #include "amalgam/render/embree_tracer.h"
 #endif
 #include "amalgam/util/atomic_file.h"
+#include "amalgam/util/version.h"
 #include "common.h"
 #include "progress.h"
 
@@ -76,12 +81,16 @@ void check_outputs(const RenderExtras& e, const std::string& ckpt, const RenderO
   if (!e.cost_image.empty() && !is_image_path(e.cost_image))
     throw InputError("--cost-image " + e.cost_image +
                      ": unsupported image format (expected .png, .exr or .pfm)");
+  if (!e.level_image.empty() && !is_image_path(e.level_image))
+    throw InputError("--level-image " + e.level_image +
+                     ": unsupported image format (expected .png, .exr or .pfm)");
   struct Output {
     const char* option;
     const std::string& path;
   };
   const Output outputs[] = {{"--out", e.out},
                             {"--cost-image", e.cost_image},
+                            {"--level-image", e.level_image},
                             {"--stats", e.stats},
                             {"--checkpoint", ckpt}};
   std::vector<std::pair<std::string, const char*>> files;  // resolved regular files
@@ -110,18 +119,75 @@ std::uint64_t film_bytes(const RenderOptions& o) {
   return MemoryModel::kProcess + pixels * MemoryModel::kPerPixel;
 }
 
-void write_cost_image(const std::string& path, const RenderOutput& r) {
-  const std::string ext = path.substr(path.find_last_of('.') + 1);
-  if (ext == "png" || ext == "PNG") {
-    write_image(path, r.width, r.height, false_colour(r.cost, true));
-    return;
+/// "--cost-range MIN,MAX": two finite numbers, 0 < MIN < MAX (a log scale). Throws InputError.
+LogRange parse_cost_range(const std::string& text) {
+  const std::string what = "--cost-range " + text + ": ";
+  const std::size_t comma = text.find(',');
+  if (comma == std::string::npos)
+    throw InputError(what + "expected two numbers MIN,MAX (e.g. 10,1000)");
+  double v[2];
+  const std::string parts[2] = {text.substr(0, comma), text.substr(comma + 1)};
+  for (int k = 0; k < 2; ++k) {
+    std::size_t end = 0;
+    try {
+      v[k] = std::stod(parts[k], &end);
+    } catch (const std::exception&) {
+      end = 0;
+    }
+    if (parts[k].empty() || end != parts[k].size() || !std::isfinite(v[k]))
+      throw InputError(what + "expected two numbers MIN,MAX (e.g. 10,1000)");
   }
-  std::vector<Vec3> raw(r.cost.size());
-  for (std::size_t i = 0; i < raw.size(); ++i) {
-    const auto v = static_cast<float>(r.cost[i]);
-    raw[i] = {v, v, v};
+  if (!(v[0] > 0.0))
+    throw InputError(what + "MIN must be greater than 0 on the log scale of the cost image");
+  if (!(v[0] < v[1])) throw InputError(what + "MIN must be less than MAX");
+  return {v[0], v[1]};
+}
+
+/// The command line as one string, each argument that needs it in single quotes.
+std::string command_text(const std::vector<std::string>& argv) {
+  std::string out;
+  for (const std::string& a : argv) {
+    if (!out.empty()) out += ' ';
+    const bool plain = !a.empty() && a.find_first_not_of(
+                                         "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMN"
+                                         "OPQRSTUVWXYZ0123456789-_.,:/=+@%") == std::string::npos;
+    if (plain) {
+      out += a;
+      continue;
+    }
+    out += '\'';
+    for (char c : a) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    out += '\'';
   }
-  write_image(path, r.width, r.height, raw);
+  return out;
+}
+
+/// The renderer options as command-line text (the EXR header's "amalgam:options").
+std::string options_text(const CommonOptions& c, int spp) {
+  const RenderOptions& o = c.options;
+  std::ostringstream f;
+  f << "--renderer " << c.renderer << " --opacity " << c.opacity << " --order " << c.order;
+  if (o.renderer == RendererKind::kScaleSensitive) {
+    if (o.level)
+      f << " --level " << *o.level;
+    else
+      f << " --footprint " << o.footprint;
+  }
+  f << " --seed " << o.seed << " --width " << o.width << " --height " << o.height << " --spp "
+    << spp << " --threads " << render_threads(o);
+  return f.str();
+}
+
+std::uint64_t peak_memory_bytes() {
+  rusage u{};
+  if (getrusage(RUSAGE_SELF, &u) != 0) return 0;
+  return static_cast<std::uint64_t>(u.ru_maxrss) * 1024;  // Linux: kibibytes
+}
+
+std::string format_range(const LogRange& r) {
+  std::ostringstream s;
+  s << r.min << ".." << r.max;
+  return s.str();
 }
 
 }  // namespace
@@ -130,6 +196,8 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   common.finish();
   const RenderOptions& o = common.options;
   const std::string ckpt = extra.checkpoint.empty() ? extra.out + ".ckpt" : extra.checkpoint;
+  std::optional<LogRange> given_range;
+  if (!extra.cost_range.empty()) given_range = parse_cost_range(extra.cost_range);
   check_outputs(extra, ckpt, o);
   const std::uint64_t asked =
       extra.max_memory.empty() ? 0 : parse_bytes(extra.max_memory, "--max-memory");
@@ -217,13 +285,47 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
       failed.push_back(what);
     }
   };
+  const LogRange range = given_range ? *given_range : own_range(r.cost);
+  const int max_level = scene.info().levels - 1;
   if (r.spp > 0) {
-    attempt(extra.out, [&] { write_image(extra.out, r.width, r.height, r.image); });
+    attempt(extra.out, [&] {
+      if (is_exr_path(extra.out)) {
+        const double top = write_render_exr(
+            extra.out, r,
+            {{"amalgam:command", command_text(extra.argv)},
+             {"amalgam:version", version()},
+             {"amalgam:scene", common.scene},
+             {"amalgam:seed", std::to_string(o.seed)},
+             {"amalgam:spp", std::to_string(r.spp)},
+             {"amalgam:options", options_text(common, r.spp)},
+             {"amalgam:cost", "cost.Y: intersection tests per pixel, total over its spp samples"},
+             {"amalgam:level", "level.Y: level of the rendered amalgams (majority of samples); " +
+                                   std::to_string(kLevelPrimitive) + ": primitives; " +
+                                   std::to_string(kLevelNothing) + ": nothing hit"}});
+        if (top > 16777216.0)
+          std::cerr << "amalgam: warning: " << extra.out << ": a pixel holds " << top
+                    << " tests, beyond 2^24: its cost.Y is rounded to float32 (the stats JSON "
+                       "is exact)\n";
+      } else {
+        write_image(extra.out, r.width, r.height, r.image);
+      }
+    });
     if (!extra.cost_image.empty())
-      attempt(extra.cost_image, [&] { write_cost_image(extra.cost_image, r); });
+      attempt(extra.cost_image, [&] { write_cost_image(extra.cost_image, r, range); });
+    if (!extra.level_image.empty())
+      attempt(extra.level_image, [&] { write_level_image(extra.level_image, r, max_level); });
   }
-  const std::string json =
-      stats_json(scene, o, r.counters, r.per_primary, r.seconds, embree_build).dump(2) + "\n";
+  nlohmann::json stats = stats_json(scene, o, r.counters, r.per_primary, r.seconds, embree_build);
+  RunInfo run;
+  run.argv = extra.argv;
+  run.width = r.width;
+  run.height = r.height;
+  run.spp = r.spp;
+  run.threads = render_threads(o);
+  run.peak_memory_bytes = peak_memory_bytes();
+  run.cost_range = range;
+  add_run_info(stats, run);
+  const std::string json = stats.dump(2) + "\n";
   if (!extra.stats.empty()) attempt(extra.stats, [&] { write_file_atomic(extra.stats, json); });
   if (r.interrupted || !failed.empty()) attempt(ckpt, [&] { write_checkpoint(ckpt, fp, state); });
   if (!failed.empty()) {
@@ -250,6 +352,13 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
       std::cerr << "Embree, BVH build " << embree_build << " s)\n";
     else
       std::cerr << r.per_primary.mean() << " tests per primary ray)\n";
+    if (!extra.cost_image.empty() && is_png_path(extra.cost_image))
+      std::cerr << "amalgam: cost image " << extra.cost_image << ": viridis, log scale "
+                << format_range(range)
+                << " tests per primary sample (colour bar along the bottom)\n";
+    if (!extra.level_image.empty() && is_png_path(extra.level_image))
+      std::cerr << "amalgam: level image " << extra.level_image << ": viridis from level 0 to "
+                << max_level << "; light grey: primitives; black: nothing hit\n";
   }
   return 0;
 }

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Renders a fixed set of scenes (every builtin, a mesh, scene files, the quick experiments) into
-# DIR, with timings removed from the stats files, so that two builds can be compared with
-# `cmp` / `diff -r`: a refactoring must leave every byte of these outputs unchanged.
+# DIR, with timings, the peak memory and the command line removed from the stats files, so that
+# two builds can be compared with `cmp` / `diff -r`: a refactoring must leave every byte of
+# these outputs unchanged.
 #   scripts/dev/snapshot.sh BINARY DIR
 set -euo pipefail
 bin=$(realpath "$1"); out=$2
@@ -15,7 +16,8 @@ r() {  # name, then render arguments
     --stats "$name.json"
   python3 - "$name.json" <<'PY'
 import json, sys
-p = sys.argv[1]; j = json.load(open(p)); j.pop("time_s", None)
+p = sys.argv[1]; j = json.load(open(p))
+for k in ("time_s", "peak_memory_bytes", "command_line"): j.pop(k, None)
 open(p, "w").write(json.dumps(j, indent=1, sort_keys=True) + "\n")
 PY
 }
@@ -37,7 +39,7 @@ r field-fp "$root/scenes/field.json" --footprint 2 --width 160 --height 120 --sp
 r field-trad "$root/scenes/field.json" --renderer traditional --width 160 --height 120 --spp 1
 r wuson-grid "$root/scenes/wuson-grid.json" --footprint 1 --width 128 --height 96 --spp 2
 r spheres "$root/scenes/spheres.json" --footprint 1 --width 96 --height 96 --spp 2
-"$bin" trace builtin:line --set n=3 --set depth=6 --renderer traditional | grep -v -E "\"(load|build|render)\":" > trace-line.txt
+"$bin" trace builtin:line --set n=3 --set depth=6 --renderer traditional | grep -v -E "\"(load|build|bake|render)\":" > trace-line.txt
 "$bin" experiment all --quick --out exp >/dev/null
 rm -f exp/report.md.tmp*
 # report.md holds wall-clock times: drop the lines that name seconds.

@@ -134,6 +134,18 @@ TEST(Metrics, SmallerThanWindow) {
   EXPECT_LT(ssim(a, blur(a, 5, 3, 1), 5, 3), 1.0);
 }
 
+// relMSE = mean over pixels and channels of (a - b)^2 / (b^2 + 0.01), b the reference.
+TEST(Metrics, RelativeMseKnownValues) {
+  const std::vector<Vec3> a = {{1, 1, 1}, {0.5f, 0.5f, 0.5f}};
+  const std::vector<Vec3> b = {{0.5f, 0.5f, 0.5f}, {0, 0, 0}};
+  // 0.25 / 0.26 on pixel 0, 0.25 / 0.01 = 25 on pixel 1 (a dark reference weighs heavily).
+  EXPECT_NEAR(rel_mse(a, b), (0.25 / 0.26 + 25.0) / 2.0, 1e-6);
+  EXPECT_EQ(rel_mse(a, a), 0.0);
+  EXPECT_NE(rel_mse(a, b), rel_mse(b, a)) << "relative to the second image";
+  EXPECT_EQ(compare_images(a, b, 2, 1).rel_mse, rel_mse(a, b));
+  EXPECT_THROW(rel_mse(a, {{0, 0, 0}}), MetricsError);
+}
+
 TEST(Metrics, SizeMismatchThrows) {
   const auto a = texture(4, 4), b = texture(4, 5);
   EXPECT_THROW(rmse(a, b), MetricsError);
@@ -183,9 +195,10 @@ TEST_F(CompareCli, IdenticalImagesPrintInf) {
   write_image(a, 16, 12, texture(16, 12));
   const CliRun r = run(a + " " + a);
   EXPECT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.out.find("rmse      0"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("psnr_db   inf"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("ssim      1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\nrmse            0\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\npsnr_db         inf\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\nssim            1\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\nrel_mse         0\n"), std::string::npos) << r.out;
 }
 
 // b = a plus 0.25 in the red channel of the left half of the pixels. Per channel the error is
@@ -203,7 +216,7 @@ TEST_F(CompareCli, JsonAndErrorImage) {
   write_image(b, w, h, shifted);
   const CliRun r = run(a + " " + b + " --json --error-image " + e);
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto j = nlohmann::json::parse(r.out);
+  const auto j = nlohmann::ordered_json::parse(r.out);
   const double rmse = std::sqrt(0.0625 / 6);
   EXPECT_EQ(j["a"], a);
   EXPECT_EQ(j["b"], b);
@@ -233,11 +246,32 @@ TEST_F(CompareCli, JsonAndErrorImage) {
       for (int ch = 0; ch < 3; ++ch)
         EXPECT_NEAR(srgb8(c[ch]), want[ch], 1) << "pixel " << x << "," << y << " channel " << ch;
     }
-  // The text form prints the same figures.
-  const CliRun text = run(a + " " + b);
+  // relMSE against the reference b: 0.0625 / (b_r^2 + 0.01) on the shifted red samples.
+  double rel = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w / 2; ++x) {
+      const double br = shifted[static_cast<std::size_t>(y) * w + x].x;
+      rel += 0.0625 / (br * br + 0.01);
+    }
+  EXPECT_NEAR(j["rel_mse"].get<double>(), rel / (3.0 * w * h), 1e-6);
+  // The text form prints the same keys, in the same order, with the same figures.
+  const CliRun text = run(a + " " + b + " --error-image " + e);
   ASSERT_EQ(text.status, 0) << text.err;
-  EXPECT_NE(text.out.find("size      16x12"), std::string::npos) << text.out;
-  EXPECT_NE(text.out.find("max_abs   0.25\n"), std::string::npos) << text.out;
+  std::istringstream lines(text.out);
+  std::string key, value;
+  auto it = j.begin();
+  int n = 0;
+  while (lines >> key >> value) {
+    ASSERT_NE(it, j.end()) << "extra key " << key;
+    EXPECT_EQ(key, it.key());
+    if (it->is_string())
+      EXPECT_EQ(value, it->get<std::string>()) << key;
+    else
+      EXPECT_NEAR(std::stod(value), it->get<double>(), 1e-5 * std::fabs(it->get<double>())) << key;
+    ++it, ++n;
+  }
+  EXPECT_EQ(it, j.end()) << "the text output lacks keys of the JSON output";
+  EXPECT_EQ(n, 12);
 }
 
 TEST_F(CompareCli, SizeMismatchIsBadInput) {

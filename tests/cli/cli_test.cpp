@@ -92,12 +92,13 @@ TEST(Cli, RenderWritesImageCostImageAndStats) {
           (d / "s.json").string());
   ASSERT_EQ(r.status, 0);
   // Both images are real 40 x 30 pictures, not just files: the render shows the prisms against
-  // the background (several colours), the cost image varies with the geometry.
+  // the background (several colours), the cost image varies with the geometry (it has its
+  // colour bar, one black row and 6 rows, appended below).
   for (const char* name : {"a.png", "c.png"}) {
     int w = 0, h = 0;
     const std::vector<amalgam::Vec3> px = amalgam::read_image((d / name).string(), w, h);
     EXPECT_EQ(w, 40) << name;
-    EXPECT_EQ(h, 30) << name;
+    EXPECT_EQ(h, name[0] == 'c' ? 37 : 30) << name;
     std::set<std::tuple<float, float, float>> colours;
     for (const amalgam::Vec3& c : px) colours.insert({c.x, c.y, c.z});
     EXPECT_GE(colours.size(), 3u) << name << " is (nearly) one colour";
@@ -123,7 +124,8 @@ TEST(Cli, RenderWritesImageCostImageAndStats) {
 
 // The cost image holds, per pixel, the intersection tests of its samples (primary and shadow
 // rays) divided by spp: raw in .pfm, so the pixels add up to the stats' total exactly; in .png
-// the same counts in false colour, viridis on a log scale (log1p(v) / log1p(max)).
+// the same counts in false colour, viridis on a log scale from the smallest to the largest
+// (colormap.h's log_colours), with a colour bar below the picture.
 TEST(Cli, CostImageCountsAddUpToTheStatsAndPngIsViridisOnALogScale) {
   const fs::path d = temp_dir() / "cost";
   fs::create_directories(d);
@@ -162,9 +164,10 @@ TEST(Cli, CostImageCountsAddUpToTheStatsAndPngIsViridisOnALogScale) {
 
   const std::vector<amalgam::Vec3> png = amalgam::read_image((d / "c.png").string(), w, h);
   ASSERT_EQ(w, 40);
-  ASSERT_EQ(h, 30);
-  const std::vector<amalgam::Vec3> expected = amalgam::false_colour(counts, true);
-  for (std::size_t i = 0; i < png.size(); ++i)
+  ASSERT_EQ(h, 37);
+  const std::vector<amalgam::Vec3> expected =
+      amalgam::log_colours(counts, amalgam::own_range(counts));
+  for (std::size_t i = 0; i < counts.size(); ++i)
     for (int c = 0; c < 3; ++c)
       ASSERT_NEAR(amalgam::linear_to_srgb(png[i][c]), amalgam::linear_to_srgb(expected[i][c]),
                   0.5 / 255 + 1e-6)
@@ -209,6 +212,15 @@ TEST(Cli, BadInputExitsTwoWithOneLineAndNoOutput) {
       {"render builtin:prisms --set view=side", "view=side"},
       {"render builtin:line --set n=8 --set depth=30", "2^58"},
       {"render builtin:line --order random", "--order"},
+      {"render builtin:line --cost-range 0,10", "--cost-range 0,10"},
+      {"render builtin:line --cost-range -1,10", "--cost-range -1,10"},
+      {"render builtin:line --cost-range 10,1", "--cost-range 10,1"},
+      {"render builtin:line --cost-range 10,10", "--cost-range 10,10"},
+      {"render builtin:line --cost-range 10", "--cost-range 10"},
+      {"render builtin:line --cost-range 1,2,3", "--cost-range 1,2,3"},
+      {"render builtin:line --cost-range a,b", "--cost-range a,b"},
+      {"render builtin:line --cost-range 1,inf", "--cost-range 1,inf"},
+      {"render builtin:line --level-image x.bmp", "--level-image"},
   };
   for (const BadCase& c : cases) {
     const std::string err = (d / "err.txt").string();

@@ -115,6 +115,9 @@ TEST(Outputs, EveryOutputIsCheckedBeforeAnyWork) {
       {"--out " + (d / "x.png") + " --stats " + (d / "adir"), "is a directory"},
       {"--out " + (d / "x.png") + " --cost-image " + (d / "c.bmp"), "unsupported image format"},
       {"--out " + (d / "x.png") + " --checkpoint " + (d / "none/c.ckpt"), "does not exist"},
+      {"--out " + (d / "x.png") + " --level-image " + (d / "l.bmp"), "unsupported image format"},
+      {"--out " + (d / "x.png") + " --level-image " + (d / "none/l.png"), "does not exist"},
+      {"--out " + (d / "x.png") + " --cost-range 0,100", "--cost-range 0,100"},
   };
   for (const Case& c : cases) {
     const CliResult r = amalgam(kLong + " " + c.args);
@@ -131,8 +134,8 @@ TEST(Outputs, TwoOutputsOnOneFileAreRefused) {
   const std::string x = d / "x.png";
   fs::create_symlink(x, d / "alias.json");
   for (const std::string& other :
-       {"--stats " + x, "--cost-image " + x, "--checkpoint " + x, "--stats " + (d / "alias.json"),
-        "--stats " + (d / "sub/../x.png")}) {
+       {"--stats " + x, "--cost-image " + x, "--level-image " + x, "--checkpoint " + x,
+        "--stats " + (d / "alias.json"), "--stats " + (d / "sub/../x.png")}) {
     fs::create_directories(d.path / "sub");
     const CliResult r = amalgam(kLong + " --out " + x + " " + other);
     EXPECT_EQ(r.status, 2) << other << ": " << r.err;

@@ -33,6 +33,7 @@ void expect_same(const LoadedScene& s, const RenderOptions& o, const std::string
   for (std::size_t i = 0; i < a.sum.size(); ++i) {
     ASSERT_EQ(a.sum[i], b.sum[i]) << what << ", pixel " << i;
     ASSERT_EQ(a.tests[i], b.tests[i]) << what << ", pixel " << i;
+    ASSERT_EQ(a.aov[i], b.aov[i]) << what << ", auxiliary outputs of pixel " << i;
   }
   EXPECT_EQ(a.counters.tests, b.counters.tests) << what;
   EXPECT_EQ(a.counters.by_level, b.counters.by_level) << what;

@@ -85,6 +85,19 @@ double rmse(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
   return std::sqrt(sum / (3.0 * static_cast<double>(a.size())));
 }
 
+double rel_mse(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double epsilon) {
+  check_same_size(a, b);
+  if (a.empty()) return 0.0;
+  double sum = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double ref = b[i][c];
+      const double d = static_cast<double>(a[i][c]) - ref;
+      sum += d * d / (ref * ref + epsilon);
+    }
+  return sum / (3.0 * static_cast<double>(a.size()));
+}
+
 double psnr(double rmse, double peak) {
   if (rmse == 0.0) return std::numeric_limits<double>::infinity();
   return 20.0 * std::log10(peak / rmse);
@@ -160,6 +173,7 @@ ImageComparison compare_images(const std::vector<Vec3>& a, const std::vector<Vec
     }
   r.mean_abs = a.empty() ? 0.0 : sum / (3.0 * static_cast<double>(a.size()));
   r.max_abs = mx;
+  r.rel_mse = rel_mse(a, b);
   return r;
 }
 

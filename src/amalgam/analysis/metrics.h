@@ -48,6 +48,12 @@ double ssim(const std::vector<Vec3>& a, const std::vector<Vec3>& b, int width, i
 /// Throws MetricsError if the sizes differ.
 std::vector<double> error_map(const std::vector<Vec3>& a, const std::vector<Vec3>& b);
 
+/// Relative mean squared error of `a` against the reference `b`, as in the denoising
+/// literature (e.g. Rousselle et al. 2011): the mean over all pixels and the three channels of
+/// linear RGB of (a - b)^2 / (b^2 + epsilon), epsilon = 0.01 keeping dark reference pixels
+/// from dominating. 0 for two empty images. Throws MetricsError if the sizes differ.
+double rel_mse(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double epsilon = 0.01);
+
 /// Every figure `amalgam compare` prints.
 struct ImageComparison {
   double rmse = 0;      ///< over all channels, linear RGB
@@ -55,6 +61,7 @@ struct ImageComparison {
   double ssim = 1;      ///< on clamped luminance
   double mean_abs = 0;  ///< mean |a - b| over all channels
   double max_abs = 0;   ///< largest |a - b| over all channels
+  double rel_mse = 0;   ///< rel_mse(a, b): b is the reference
 };
 
 /// All the metrics above for two width x height images. Throws MetricsError if either

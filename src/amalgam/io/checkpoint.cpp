@@ -1,10 +1,13 @@
 #include "amalgam/io/checkpoint.h"
 
+#include <cctype>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <sstream>
 #include <string_view>
+#include <vector>
 
 #include "amalgam/math/random.h"
 #include "amalgam/util/atomic_file.h"
@@ -13,7 +16,10 @@
 namespace amalgam {
 namespace {
 
-constexpr char kMagic[] = "AMALGAM-CHECKPOINT-2";
+/// The format version is the last part of the magic; version 3 added the auxiliary outputs
+/// (PixelAov) after the tests per pixel.
+constexpr char kMagicPrefix[] = "AMALGAM-CHECKPOINT-";
+constexpr char kMagic[] = "AMALGAM-CHECKPOINT-3";
 
 /// Checksum of a checkpoint's bytes (everything before the checksum itself): 64-bit words
 /// through hash_combine, so any flipped bit changes it (with probability 1 - 2^-64).
@@ -30,9 +36,15 @@ std::uint64_t checksum(std::string_view bytes) {
   return hash_combine(h, tail);
 }
 
+/// Appends raw bytes to a string reserved to the checkpoint's exact size, so the film is held
+/// once more while writing, not twice or three times as a growing stream would (MemoryModel).
 template <class T>
-void put(std::ostream& out, const T& v) {
-  out.write(reinterpret_cast<const char*>(&v), sizeof v);
+void put(std::string& out, const T& v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+template <class T>
+void put_array(std::string& out, const std::vector<T>& v) {
+  out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
 }
 template <class T>
 void get(std::istream& in, T& v) {
@@ -43,25 +55,29 @@ void get(std::istream& in, T& v) {
 
 void write_checkpoint(const std::string& path, const std::string& fingerprint,
                       const FilmState& st) {
-  std::ostringstream out(std::ios::binary);
-  out.write(kMagic, sizeof kMagic);
-  put(out, static_cast<std::uint64_t>(fingerprint.size()));
-  out.write(fingerprint.data(), static_cast<std::streamsize>(fingerprint.size()));
-  put(out, st.width);
-  put(out, st.height);
-  put(out, st.spp_done);
-  out.write(reinterpret_cast<const char*>(st.sum.data()),
-            static_cast<std::streamsize>(st.sum.size() * sizeof(Vec3)));
-  out.write(reinterpret_cast<const char*>(st.tests.data()),
-            static_cast<std::streamsize>(st.tests.size() * sizeof(std::uint64_t)));
-  put(out, st.counters);
   std::uint64_t distinct = 0;
   st.per_primary.for_each([&](std::uint64_t, std::uint64_t) { ++distinct; });
-  put(out, distinct);
-  st.per_primary.for_each([&](std::uint64_t v, std::uint64_t c) { put(out, v), put(out, c); });
-  std::string bytes = out.str();
+  std::vector<PixelAov> zero;  // a FilmState made outside render() may have no AOVs yet
+  if (st.aov.size() != st.sum.size()) zero.assign(st.sum.size(), PixelAov{});
+  const std::vector<PixelAov>& aov = zero.empty() ? st.aov : zero;
+  std::string bytes;
+  bytes.reserve(sizeof kMagic + 8 + fingerprint.size() + 3 * sizeof(int) +
+                st.sum.size() * (sizeof(Vec3) + sizeof(std::uint64_t) + sizeof(PixelAov)) +
+                sizeof(Counters) + 8 + distinct * 16 + 8);
+  bytes.append(kMagic, sizeof kMagic);
+  put(bytes, static_cast<std::uint64_t>(fingerprint.size()));
+  bytes.append(fingerprint);
+  put(bytes, st.width);
+  put(bytes, st.height);
+  put(bytes, st.spp_done);
+  put_array(bytes, st.sum);
+  put_array(bytes, st.tests);
+  put_array(bytes, aov);
+  put(bytes, st.counters);
+  put(bytes, distinct);
+  st.per_primary.for_each([&](std::uint64_t v, std::uint64_t c) { put(bytes, v), put(bytes, c); });
   const std::uint64_t sum = checksum(bytes);
-  bytes.append(reinterpret_cast<const char*>(&sum), sizeof sum);
+  put(bytes, sum);
   write_file_atomic(path, bytes);
 }
 
@@ -69,8 +85,19 @@ FilmState read_checkpoint(const std::string& path, const std::string& fingerprin
   std::ifstream file(path, std::ios::binary);
   if (!file) throw InputError(path + ": cannot open checkpoint: " + std::strerror(errno));
   std::string bytes{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
-  if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
-    throw InputError(path + ": not an amalgam checkpoint (or one of an older version)");
+  if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) {
+    if (bytes.compare(0, sizeof kMagicPrefix - 1, kMagicPrefix) == 0) {
+      std::string format;
+      for (std::size_t i = sizeof kMagicPrefix - 1;
+           i < bytes.size() && format.size() < 4 &&
+           std::isdigit(static_cast<unsigned char>(bytes[i]));
+           ++i)
+        format += bytes[i];
+      throw InputError(path + ": checkpoint of another amalgam version (format " + format +
+                       ", this one reads format 3): delete it and render again");
+    }
+    throw InputError(path + ": not an amalgam checkpoint");
+  }
   std::uint64_t stored = 0;
   if (bytes.size() < sizeof kMagic + sizeof stored)
     throw InputError(path + ": checkpoint is truncated");
@@ -97,10 +124,13 @@ FilmState read_checkpoint(const std::string& path, const std::string& fingerprin
   const std::size_t pixels = static_cast<std::size_t>(st.width) * st.height;
   st.sum.resize(pixels);
   st.tests.resize(pixels);
+  st.aov.resize(pixels);
   in.read(reinterpret_cast<char*>(st.sum.data()),
           static_cast<std::streamsize>(pixels * sizeof(Vec3)));
   in.read(reinterpret_cast<char*>(st.tests.data()),
           static_cast<std::streamsize>(pixels * sizeof(std::uint64_t)));
+  in.read(reinterpret_cast<char*>(st.aov.data()),
+          static_cast<std::streamsize>(pixels * sizeof(PixelAov)));
   get(in, st.counters);
   std::uint64_t distinct = 0;
   get(in, distinct);
@@ -113,6 +143,11 @@ FilmState read_checkpoint(const std::string& path, const std::string& fingerprin
     throw InputError(path + ": checkpoint is truncated or has trailing data");
   for (const Vec3& v : st.sum)
     if (!is_finite(v)) throw InputError(path + ": checkpoint holds a non-finite pixel sum");
+  const auto spp = static_cast<std::uint64_t>(st.spp_done);
+  for (const PixelAov& a : st.aov)
+    if (!is_finite(a.normal) || !is_finite(a.albedo) || !std::isfinite(a.depth) ||
+        std::uint64_t{a.amalgams} + a.primitives > spp)
+      throw InputError(path + ": checkpoint holds an invalid auxiliary pixel sum");
   return st;
 }
 

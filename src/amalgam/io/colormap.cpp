@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "amalgam/io/srgb.h"
 
@@ -26,8 +27,9 @@ constexpr std::array<std::array<float, 3>, 33> kViridisSrgb = {{
     {0.8359f, 0.8861f, 0.1025f}, {0.9166f, 0.8961f, 0.1008f}, {0.9932f, 0.9062f, 0.1439f},
 }};
 
-/// Viridis at t in [0, 1], as linear RGB.
-Vec3 viridis_linear(double t) {
+}  // namespace
+
+Vec3 viridis(double t) {
   constexpr int kSegments = static_cast<int>(kViridisSrgb.size()) - 1;
   const double s = std::clamp(t, 0.0, 1.0) * kSegments;
   const int k = std::min(static_cast<int>(s), kSegments - 1);
@@ -39,8 +41,6 @@ Vec3 viridis_linear(double t) {
   }
   return out;
 }
-
-}  // namespace
 
 std::vector<Vec3> false_colour(const std::vector<double>& values, bool log_scale,
                                double* vmax_out) {
@@ -58,10 +58,59 @@ std::vector<Vec3> false_colour(const std::vector<double>& values, bool log_scale
       t = 1.0;
     else  // here 0 < v < vmax, so denom > 0
       t = (log_scale ? std::log1p(v) : v) / denom;
-    colours.push_back(viridis_linear(t));
+    colours.push_back(viridis(t));
   }
   if (vmax_out) *vmax_out = vmax;
   return colours;
+}
+
+}  // namespace amalgam
+
+namespace amalgam {
+
+LogRange own_range(const std::vector<double>& values) {
+  double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+  for (double v : values)
+    if (std::isfinite(v) && v > 0.0) lo = std::min(lo, v), hi = std::max(hi, v);
+  if (!(hi > 0.0)) return {1.0, 1.0};
+  return {lo, hi};
+}
+
+double log_position(double v, const LogRange& r) {
+  if (std::isnan(v) || v <= r.min) return v >= r.max ? 1.0 : 0.0;
+  if (v >= r.max) return 1.0;
+  return std::clamp((std::log(v) - std::log(r.min)) / (std::log(r.max) - std::log(r.min)), 0.0,
+                    1.0);
+}
+
+std::vector<Vec3> log_colours(const std::vector<double>& values, const LogRange& r) {
+  std::vector<Vec3> out;
+  out.reserve(values.size());
+  for (double v : values) out.push_back(viridis(log_position(v, r)));
+  return out;
+}
+
+std::vector<Vec3> with_colour_bar(const std::vector<Vec3>& image, int width, int height,
+                                  const LogRange& r, int& out_height) {
+  const int bar = std::max(6, height / 10);
+  out_height = height + 1 + bar;
+  std::vector<Vec3> out(image);
+  out.resize(static_cast<std::size_t>(width) * out_height, Vec3{});  // the black row
+  const double lmin = std::log(r.min), lmax = std::log(r.max);
+  std::vector<bool> tick(static_cast<std::size_t>(width), false);
+  if (lmax > lmin)
+    for (double p = std::ceil(std::log10(r.min)); p <= std::log10(r.max); p += 1.0) {
+      const double t = (p * std::log(10.0) - lmin) / (lmax - lmin);
+      const int x = std::clamp(static_cast<int>(t * width), 0, width - 1);
+      tick[static_cast<std::size_t>(x)] = true;
+    }
+  for (int y = height + 1; y < out_height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const bool top = y < height + 1 + bar / 3;
+      out[static_cast<std::size_t>(y) * width + x] =
+          top && tick[static_cast<std::size_t>(x)] ? Vec3{1, 1, 1} : viridis((x + 0.5) / width);
+    }
+  return out;
 }
 
 }  // namespace amalgam

@@ -37,7 +37,7 @@ bool is_image_path(const std::string& path) {
 }
 
 void write_image(const std::string& path, int width, int height,
-                 const std::vector<Vec3>& linear_rgb) {
+                 const std::vector<Vec3>& linear_rgb, const ImageText& text) {
   const Format format = image_format(path);
   if (width <= 0 || height <= 0)
     throw ImageIoError(path + ": invalid image size " + std::to_string(width) + "x" +
@@ -48,13 +48,13 @@ void write_image(const std::string& path, int width, int height,
   write_atomically<ImageIoError>(path, [&](AtomicFile& out) {
     switch (format) {
       case Format::kPng:
-        codec::write_png(out, width, height, linear_rgb);
+        codec::write_png(out, width, height, linear_rgb, text);
         break;
       case Format::kPfm:
         codec::write_pfm(out, width, height, linear_rgb);
         break;
       case Format::kExr:
-        codec::write_exr(out, width, height, linear_rgb);
+        codec::write_exr(out, width, height, linear_rgb, text);
         break;
     }
   });

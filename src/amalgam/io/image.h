@@ -6,6 +6,7 @@
 /// is either left untouched or holds a complete file.
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "amalgam/math/vec.h"
@@ -27,16 +28,19 @@ bool is_image_path(const std::string& path);
 /// The format follows the extension of `path` (case-insensitive):
 ///   .png  8-bit sRGB (values clamped to [0, 1], sRGB transfer function, rounded);
 ///   .pfm  little-endian 32-bit float RGB ("PF", scale -1.0, rows stored bottom-to-top);
-///   .exr  half-float RGB (OpenEXR, ZIP compression, no alpha channel, i.e. opaque).
+///   .exr  float32 RGB (OpenEXR, ZIP compression, no alpha channel, i.e. opaque).
+/// `text` (key, value) pairs are stored as PNG tEXt chunks or OpenEXR string attributes (a PFM
+/// has no place for them: they are dropped).
 /// Throws ImageIoError for any other extension, for a size mismatch, or on any I/O error.
+using ImageText = std::vector<std::pair<std::string, std::string>>;
 void write_image(const std::string& path, int width, int height,
-                 const std::vector<Vec3>& linear_rgb);
+                 const std::vector<Vec3>& linear_rgb, const ImageText& text = {});
 
 /// Reads a .png (8/16-bit grey, grey+alpha, RGB, RGBA or palette; alpha is ignored and sRGB
 /// is decoded to linear), .pfm (colour "PF" or grey "Pf", either endianness; the magnitude of
-/// the scale is ignored) or .exr (via the RGBA interface; alpha ignored) file. Sets width and
-/// height and returns pixels in the same layout write_image takes. Throws ImageIoError naming
-/// the file on any error.
+/// the scale is ignored) or .exr (its R, G and B channels as float; other layers ignored) file.
+/// Sets width and height and returns pixels in the same layout write_image takes. Throws
+/// ImageIoError naming the file on any error.
 std::vector<Vec3> read_image(const std::string& path, int& width, int& height);
 
 }  // namespace amalgam

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "amalgam/io/codec.h"
 #include "amalgam/io/srgb.h"
@@ -32,7 +34,7 @@ void png_warning_handler(png_structp, png_const_charp) {}
 
 /// Writes 8-bit RGB rows (top row first). Returns false with err.message set on failure.
 bool png_write_rgb8(std::FILE* fp, int width, int height, const std::uint8_t* rgb,
-                    PngErrorState& err) {
+                    const std::vector<png_text>& text, PngErrorState& err) {
   png_structp png =
       png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, png_error_handler, png_warning_handler);
   if (!png) return false;
@@ -50,6 +52,7 @@ bool png_write_rgb8(std::FILE* fp, int width, int height, const std::uint8_t* rg
                PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                PNG_FILTER_TYPE_DEFAULT);
   png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+  if (!text.empty()) png_set_text(png, info, text.data(), static_cast<int>(text.size()));
   png_write_info(png, info);
   const std::size_t stride = static_cast<std::size_t>(width) * 3;
   for (int y = 0; y < height; ++y) png_write_row(png, rgb + static_cast<std::size_t>(y) * stride);
@@ -112,15 +115,26 @@ bool png_read_samples(std::FILE* fp, std::vector<std::uint8_t>& buf, PngLayout& 
 
 }  // namespace
 
-void write_png(AtomicFile& out, int width, int height, const std::vector<Vec3>& pixels) {
+void write_png(AtomicFile& out, int width, int height, const std::vector<Vec3>& pixels,
+               const std::vector<std::pair<std::string, std::string>>& text) {
   std::vector<std::uint8_t> rgb(pixels.size() * 3);
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     rgb[3 * i + 0] = encode_srgb8(pixels[i].x);
     rgb[3 * i + 1] = encode_srgb8(pixels[i].y);
     rgb[3 * i + 2] = encode_srgb8(pixels[i].z);
   }
+  std::vector<png_text> chunks;
+  for (const auto& [key, value] : text) {
+    if (key.empty() || key.size() > 79) throw Failure("PNG text key must have 1 to 79 characters");
+    png_text t{};
+    t.compression = PNG_TEXT_COMPRESSION_NONE;
+    t.key = const_cast<char*>(key.c_str());  // libpng copies the text; it does not modify it
+    t.text = const_cast<char*>(value.c_str());
+    t.text_length = value.size();
+    chunks.push_back(t);
+  }
   PngErrorState err;
-  if (!png_write_rgb8(out.stream(), width, height, rgb.data(), err))
+  if (!png_write_rgb8(out.stream(), width, height, rgb.data(), chunks, err))
     throw Failure(std::string("PNG encoding failed: ") + err.message);
 }
 

@@ -1,6 +1,20 @@
 #include "amalgam/io/stats_json.h"
 
+#include <cmath>
+
+#include "amalgam/util/version.h"
+
 namespace amalgam {
+namespace {
+
+/// A count held as a double (an implicit hierarchy's can exceed 2^64) as a JSON integer when
+/// it is one that a double holds exactly, else as a number.
+nlohmann::json count(double v) {
+  if (v >= 0 && v <= 9007199254740992.0 && std::floor(v) == v) return static_cast<std::uint64_t>(v);
+  return v;
+}
+
+}  // namespace
 
 nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, const Counters& c,
                           const CostDistribution& d, double render_seconds,
@@ -18,8 +32,8 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
   j["tracer"] = embree ? "embree" : "amalgam";
   j["seed"] = o.seed;
   j["scene"] = {{"name", scene.name},
-                {"primitives", info.primitives},
-                {"nodes", info.nodes},
+                {"primitives", count(info.primitives)},
+                {"nodes", count(info.nodes)},
                 {"levels", info.levels}};
   j["rays"] = {{"primary", c.rays[0]}, {"shadow", c.rays[1]}};
   json by_level = json::array();
@@ -37,8 +51,11 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
                 {"by_level", by_level}};
   j["per_primary_ray"] = {
       {"mean", d.mean()}, {"p50", d.quantile(0.5)}, {"p99", d.quantile(0.99)}, {"max", d.max()}};
-  j["time_s"] = {
-      {"load", scene.load_seconds}, {"build", scene.build_seconds}, {"render", render_seconds}};
+  j["time_s"] = {{"load", scene.load_seconds},
+                 {"build", scene.build_seconds},
+                 {"bake", scene.bake_seconds},
+                 {"render", render_seconds}};
+  j["version"] = version();
   if (embree) {
     j["opacity"] = nullptr;
     j["order"] = nullptr;
@@ -47,6 +64,22 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
     j["time_s"]["embree_build"] = embree_build_seconds;
   }
   return j;
+}
+
+void add_run_info(nlohmann::json& j, const RunInfo& info) {
+  j["width"] = info.width;
+  j["height"] = info.height;
+  j["spp"] = info.spp;
+  j["threads"] = info.threads;
+  j["command_line"] = info.argv;
+  j["peak_memory_bytes"] = info.peak_memory_bytes;
+  if (info.cost_range)
+    j["cost_range"] = {{"min", info.cost_range->min},
+                       {"max", info.cost_range->max},
+                       {"scale", "log"},
+                       {"unit", "tests per primary sample"}};
+  else
+    j["cost_range"] = nullptr;
 }
 
 }  // namespace amalgam

@@ -1,8 +1,14 @@
 #pragma once
-/// \file The stats JSON of CONTRACT.md ("renderer", "scene", "rays", "tests", ...).
+/// \file The stats JSON of CONTRACT.md ("renderer", "scene", "rays", "tests", ...), with the
+/// run's description (docs/outputs.md lists every key and its unit).
 
+#include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
 
+#include "amalgam/io/colormap.h"
 #include "amalgam/render/loaded_scene.h"
 #include "amalgam/render/options.h"
 #include "amalgam/stats/counters.h"
@@ -18,5 +24,21 @@ namespace amalgam {
 nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& options,
                           const Counters& counters, const CostDistribution& per_primary,
                           double render_seconds, double embree_build_seconds = 0.0);
+
+/// What a whole render adds to its stats object.
+struct RunInfo {
+  std::vector<std::string> argv;  ///< the command line, as given
+  int width = 0, height = 0;
+  int spp = 0;      ///< samples per pixel the outputs hold
+  int threads = 0;  ///< worker threads used
+  std::uint64_t peak_memory_bytes = 0;
+  /// The cost PNG's scale (--cost-range, else the image's own range), also when no PNG is
+  /// written: the range to give another render's --cost-range to compare the two.
+  std::optional<LogRange> cost_range;
+};
+
+/// Adds "width", "height", "spp", "threads", "command_line", "peak_memory_bytes" and
+/// "cost_range" ({"min", "max", "scale": "log", "unit"}) to `j`.
+void add_run_info(nlohmann::json& j, const RunInfo& info);
 
 }  // namespace amalgam

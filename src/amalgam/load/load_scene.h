@@ -22,7 +22,8 @@ AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config = {})
 SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& config = {});
 
 /// Loads a scene path: `.json` (any case) as a scene file, anything else as a mesh; builds
-/// and bakes its hierarchy (build_hierarchy). Sets load_seconds (reading) and build_seconds.
+/// and bakes its hierarchy (build_hierarchy). Sets load_seconds (reading), build_seconds and
+/// bake_seconds (the bake apart from the rest of the build).
 LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config = {});
 
 /// Loads `spec`. Throws InputError (one line naming the scene and the problem) on bad input,

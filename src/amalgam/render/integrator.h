@@ -21,6 +21,12 @@ AMALGAM_ISA_BEGIN
 struct SampleResult {
   Vec3 colour;
   TraceHit hit;
+  /// Auxiliary outputs of the sample, blended front to back with the same weights as `colour`
+  /// (a miss adds 0): the shading normal turned toward the viewer (for a cloud, the mean
+  /// normal of its visible facets, which points at the viewer) and the diffuse colour of the
+  /// surface shaded.
+  Vec3 normal{};
+  Vec3 albedo{};
 };
 
 /// `Tracer` finds hits: `intersect(ray, key, translucent*) -> TraceHit` and
@@ -41,7 +47,8 @@ class Integrator {
     const TraceHit hit =
         trav_.intersect(primary, hash_combine(key, 0), Opacity::kBlends ? &translucent_ : nullptr);
     std::uint64_t shadow_stream = 1;
-    Vec3 colour{};
+    SampleResult r{{}, hit};
+    const Vec3 wo = -primary.dir;
     float through = 1.0f;
     if constexpr (Opacity::kBlends) {
       std::sort(translucent_.begin(), translucent_.end(), [](const auto& a, const auto& b) {
@@ -49,24 +56,39 @@ class Integrator {
       });
       for (const TranslucentHit& a : translucent_) {
         const Appearance app = h_.appearance(a.id);
-        colour += shade(primary, a.id, app, a.surf, key, shadow_stream) * (through * a.opacity);
+        const float w = through * a.opacity;
+        r.colour += shade(primary, a.id, app, a.surf, key, shadow_stream) * w;
+        r.normal += amalgam_normal(app, a.surf, wo) * w;
+        r.albedo += app.surface.colour * w;
         through *= 1.0f - a.opacity;
       }
     }
     Vec3 end = env_.background;
     if (hit.kind == TraceHit::Kind::kPrimitive) {
-      end = direct(primary, hit.surf, hit.surf.normal, h_.surface(hit.id), key, shadow_stream);
+      const Surface surf = h_.surface(hit.id);
+      end = direct(primary, hit.surf, hit.surf.normal, surf, key, shadow_stream);
+      r.normal += facing(hit.surf.normal, wo) * through;
+      r.albedo += surf.colour * through;
     } else if (hit.kind == TraceHit::Kind::kAmalgam) {
       const Appearance app = h_.appearance(hit.id);
       end = shade(primary, hit.id, app, hit.surf, key, shadow_stream);
+      r.normal += amalgam_normal(app, hit.surf, wo) * through;
+      r.albedo += app.surface.colour * through;
     }
-    colour += end * through;
-    return {colour, hit};
+    r.colour += end * through;
+    return r;
   }
 
  private:
   static Vec3 shading_normal(const Appearance& app, const SurfaceHit& s) {
     return (app.normal == Vec3{}) ? s.normal : app.normal;
+  }
+  /// `n` turned toward the viewer direction `wo`, as direct() shades with it.
+  static Vec3 facing(Vec3 n, Vec3 wo) { return dot(n, wo) < 0 ? -n : n; }
+  /// The normal output of a rendered amalgam: the one shade() lights it with, or for a cloud
+  /// (isotropic facets, cloud_response) the mean normal of its facets seen from `wo`: `wo`.
+  static Vec3 amalgam_normal(const Appearance& app, const SurfaceHit& s, Vec3 wo) {
+    return app.shading == Shading::kCloud ? wo : facing(shading_normal(app, s), wo);
   }
 
   /// A rendered amalgam `id` with appearance `app`, entered at `s`.

@@ -22,8 +22,9 @@ struct LoadedScene {
   std::string name;
   AnyHierarchy hierarchy;
   Environment env;
-  double load_seconds = 0.0;
-  double build_seconds = 0.0;
+  double load_seconds = 0.0;   ///< reading the scene (or making a builtin's)
+  double build_seconds = 0.0;  ///< building the hierarchy, the bake not included
+  double bake_seconds = 0.0;   ///< baking the amalgams' appearances
   /// For builtin scenes: the parameters as applied (Params::applied); part of content_hash.
   std::string params{};
 

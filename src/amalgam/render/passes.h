@@ -14,11 +14,26 @@
 #include <vector>
 
 #include "amalgam/math/random.h"
+#include "amalgam/render/integrator.h"
 #include "amalgam/render/render.h"
 #include "amalgam/util/isa.h"
 
 namespace amalgam {
 AMALGAM_ISA_BEGIN
+
+/// Adds one sample's auxiliary outputs to its pixel's sums (PixelAov, render.h).
+inline void add_sample(PixelAov& a, const SampleResult& r) {
+  a.normal += r.normal;
+  a.albedo += r.albedo;
+  if (r.hit.kind == TraceHit::Kind::kNone) return;
+  a.depth += r.hit.t;
+  if (r.hit.kind == TraceHit::Kind::kPrimitive) {
+    ++a.primitives;
+  } else {
+    ++a.amalgams;
+    a.level_sum += static_cast<std::uint32_t>(r.hit.level);
+  }
+}
 
 /// Adds samples st.spp_done .. o.spp - 1 to `st` (sized for o.width x o.height), in passes of
 /// whole samples per pixel over 8x8 tiles on o.threads threads (0: all). Pixel (x, y),
@@ -37,17 +52,16 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
   // Samples per pass: whole samples for every pixel, about 2^16 primary rays per pass so that
   // small images do not pay for many passes and large ones can stop quickly.
   const int per_pass = std::max(1, static_cast<int>(65536 / std::max<std::size_t>(pixels, 1)));
-  // More threads than the machine runs at once buys nothing (and makes oneTBB print a warning):
-  // at most its concurrency. The image does not depend on the thread count.
-  const int cores = tbb::this_task_arena::max_concurrency();
-  const int threads = o.threads > 0 ? std::min(o.threads, cores) : cores;
-  tbb::task_arena arena(threads);
+  tbb::task_arena arena(render_threads(o));
   std::vector<Vec3> pass_sum;
   std::vector<std::uint64_t> pass_tests;
+  std::vector<PixelAov> pass_aov;
+  if (st.aov.size() != pixels) st.aov.assign(pixels, PixelAov{});  // a FilmState made elsewhere
   while (st.spp_done < o.spp) {
     const int s0 = st.spp_done, s1 = std::min(o.spp, s0 + per_pass);
     pass_sum = st.sum;  // continue each pixel's running sum in sample order
     pass_tests = st.tests;
+    pass_aov = st.aov;
     tbb::enumerable_thread_specific<ThreadState> states;
     std::atomic<bool> stopped{false};
     arena.execute([&] {
@@ -65,6 +79,7 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
                               const std::uint64_t pixel_key = hash_combine(o.seed, pix);
                               Vec3 sum = pass_sum[pix];
                               std::uint64_t tests = 0;
+                              PixelAov aov = pass_aov[pix];
                               for (int s = s0; s < s1; ++s) {
                                 const std::uint64_t key =
                                     hash_combine(pixel_key, static_cast<std::uint64_t>(s));
@@ -73,13 +88,16 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
                                 const float fy = static_cast<float>(y) + jitter.next();
                                 const Ray ray = camera.generate(fx, fy, o.width, o.height);
                                 const std::uint64_t before = ts.counters.total();
-                                sum += integrator.li(ray, key).colour;
+                                const SampleResult r = integrator.li(ray, key);
+                                sum += r.colour;
+                                add_sample(aov, r);
                                 const std::uint64_t cost = ts.counters.total() - before;
                                 ts.per_primary.add(cost);
                                 tests += cost;
                               }
                               pass_sum[pix] = sum;
                               pass_tests[pix] += tests;
+                              pass_aov[pix] = aov;
                             }
                           }
                         });
@@ -87,6 +105,7 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
     if (stopped.load()) return true;  // the pass is incomplete: discard it
     st.sum.swap(pass_sum);
     st.tests.swap(pass_tests);
+    st.aov.swap(pass_aov);
     for (const ThreadState& ts : states) {
       st.counters.merge(ts.counters);
       st.per_primary.merge(ts.per_primary);

@@ -1,5 +1,8 @@
 #include "amalgam/render/render.h"
 
+#include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
 #include <chrono>
 #include <type_traits>
 
@@ -35,10 +38,18 @@ void start_film(FilmState& st, const RenderOptions& o) {
     st.height = o.height;
     st.sum.assign(pixels, Vec3{});
     st.tests.assign(pixels, 0);
+    st.aov.assign(pixels, PixelAov{});
   }
   if (st.width != o.width || st.height != o.height || st.sum.size() != pixels ||
-      st.spp_done > o.spp)
+      st.aov.size() != pixels || st.spp_done > o.spp)
     throw InputError("resume: the saved render does not match these options");
+}
+
+int render_threads(const RenderOptions& o) {
+  // More threads than the machine runs at once buys nothing (and makes oneTBB print a
+  // warning). The image does not depend on the thread count.
+  const int cores = tbb::this_task_arena::max_concurrency();
+  return o.threads > 0 ? std::min(o.threads, cores) : cores;
 }
 
 RenderOutput finish(const FilmState& st) {
@@ -46,12 +57,31 @@ RenderOutput finish(const FilmState& st) {
   out.width = st.width;
   out.height = st.height;
   out.spp = st.spp_done;
-  out.image.resize(st.sum.size());
-  out.cost.resize(st.sum.size());
+  const std::size_t n = st.sum.size();
+  out.image.resize(n);
+  out.cost.resize(n);
+  out.tests = st.tests;
+  out.depth.resize(n);
+  out.level.resize(n);
+  out.normal.resize(n);
+  out.albedo.resize(n);
   const float inv = st.spp_done > 0 ? 1.0f / static_cast<float>(st.spp_done) : 0.0f;
-  for (std::size_t i = 0; i < st.sum.size(); ++i) {
+  const std::uint32_t spp = static_cast<std::uint32_t>(std::max(st.spp_done, 0));
+  for (std::size_t i = 0; i < n; ++i) {
     out.image[i] = st.sum[i] * inv;
     out.cost[i] = st.spp_done > 0 ? static_cast<double>(st.tests[i]) / st.spp_done : 0.0;
+    const PixelAov a = i < st.aov.size() ? st.aov[i] : PixelAov{};
+    const std::uint32_t hits = a.amalgams + a.primitives;
+    const std::uint32_t misses = spp >= hits ? spp - hits : 0;
+    out.depth[i] = hits > 0 ? a.depth / static_cast<float>(hits) : kInfinity;
+    out.normal[i] = a.normal * inv;
+    out.albedo[i] = a.albedo * inv;
+    if (a.amalgams > 0 && a.amalgams >= a.primitives && a.amalgams >= misses)
+      out.level[i] = static_cast<float>(static_cast<double>(a.level_sum) / a.amalgams);
+    else if (a.primitives > 0 && a.primitives >= misses)
+      out.level[i] = kLevelPrimitive;
+    else
+      out.level[i] = kLevelNothing;
   }
   out.counters = st.counters;
   out.per_primary = st.per_primary;

@@ -13,12 +13,38 @@
 
 namespace amalgam {
 
+/// The value of the rendered-level output (RenderOutput::level) where a pixel's samples mostly
+/// met nothing, or mostly a primitive (at full detail, no amalgam rendered).
+inline constexpr float kLevelNothing = -1.0f;
+inline constexpr float kLevelPrimitive = -2.0f;
+
+/// A pixel's auxiliary outputs summed over its samples, in sample order (docs/outputs.md).
+/// All fields are 4 bytes wide, so the struct has no padding and is stored as raw bytes in a
+/// checkpoint.
+struct PixelAov {
+  Vec3 normal{};                 ///< shading normals turned toward the viewer; a miss adds 0
+  Vec3 albedo{};                 ///< diffuse colours of what was shaded; a miss adds 0
+  float depth = 0.0f;            ///< distances t of the primary hits (misses add nothing)
+  std::uint32_t amalgams = 0;    ///< samples whose primary ray ended at a rendered amalgam
+  std::uint32_t primitives = 0;  ///< samples whose primary ray ended at a primitive
+  std::uint32_t level_sum = 0;   ///< sum of the levels of those rendered amalgams
+  friend bool operator==(const PixelAov&, const PixelAov&) = default;
+};
+static_assert(sizeof(PixelAov) == 40, "PixelAov is stored in checkpoints as raw bytes");
+
 /// Everything a render measured.
 struct RenderOutput {
   int width = 0, height = 0, spp = 0;  ///< spp: samples per pixel the image holds
   bool interrupted = false;            ///< stopped by RenderControl::cancel before options.spp
   std::vector<Vec3> image;             ///< linear RGB, mean over samples, row-major from the top
-  std::vector<double> cost;      ///< intersection tests per pixel (all rays of its samples) / spp
+  std::vector<double> cost;  ///< intersection tests per pixel (all rays of its samples) / spp
+  std::vector<std::uint64_t> tests;  ///< intersection tests per pixel, total over its samples
+  /// Auxiliary outputs (docs/outputs.md): depth, the mean t over the samples that hit something
+  /// (+inf if none did); normal and albedo, means over all samples (a miss counts as 0);
+  /// level, by the majority of samples: the mean level of the rendered amalgams when most
+  /// samples rendered one, else kLevelPrimitive or kLevelNothing (ties: amalgam, primitive).
+  std::vector<float> depth, level;
+  std::vector<Vec3> normal, albedo;
   Counters counters;             ///< exact totals, merged over threads
   CostDistribution per_primary;  ///< tests per primary ray including its shadow rays
   double seconds = 0.0;
@@ -31,6 +57,7 @@ struct FilmState {
   int width = 0, height = 0, spp_done = 0;
   std::vector<Vec3> sum;
   std::vector<std::uint64_t> tests;
+  std::vector<PixelAov> aov;  ///< empty is taken as all zero (render_passes sizes it)
   Counters counters;
   CostDistribution per_primary;
 };
@@ -70,6 +97,10 @@ struct TraceOutput {
 
 /// Traces one primary ray with its shadow rays (random stream hash(seed, 0, 0)).
 TraceOutput trace(const LoadedScene& scene, const RenderOptions& options, const Ray& ray);
+
+/// The worker threads a render with these options runs on: options.threads (0: all cores),
+/// at most the machine's concurrency.
+int render_threads(const RenderOptions& options);
 
 /// Throws InputError when options do not fit the scene (e.g. --level beyond l_max) or the
 /// tracer (Embree renders at full detail only: the traditional renderer).

@@ -4,12 +4,22 @@
 #include <oneapi/tbb/parallel_for.h>
 
 #include <algorithm>
+#include <chrono>
 
 #include "amalgam/hierarchy/build/sah.h"
 #include "amalgam/util/check.h"
 
 namespace amalgam {
 namespace {
+
+/// bake(), its wall time added to *seconds when given (the stats JSON's "bake").
+template <class H>
+void timed_bake(H& h, const BakeConfig& bc, double* seconds) {
+  const auto t0 = std::chrono::steady_clock::now();
+  bake(h, bc);
+  if (seconds)
+    *seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 SahConfig sah_config(const BuildConfig& config) {
   AMALGAM_CHECK(config.arity >= 2 && config.arity <= kMaxChildren,
@@ -62,7 +72,7 @@ ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surfa
   h.levels = t.depth + 2;  // primitives one level below the deepest leaf
   BakeConfig bc = config.bake;
   bc.parallel = bc.parallel && config.parallel;
-  bake(h, bc);
+  timed_bake(h, bc, config.bake_seconds);
   return h;
 }
 
@@ -96,7 +106,7 @@ InstancedHierarchy build_instanced(std::vector<ExplicitHierarchy> meshes,
 
   BakeConfig bc = config.bake;
   bc.parallel = bc.parallel && config.parallel;
-  bake(h, bc);
+  timed_bake(h, bc, config.bake_seconds);
   return h;
 }
 

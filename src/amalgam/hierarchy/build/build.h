@@ -24,7 +24,11 @@ struct MemoryModel {
   static constexpr std::uint64_t kSceneFile = 8u << 20;  ///< reading a scene file or mesh
   static constexpr std::uint64_t kPerTriangle = 250;     ///< explicit hierarchy, at its peak
   static constexpr std::uint64_t kPerInstance = 320;     ///< instanced hierarchy
-  static constexpr std::uint64_t kPerPixel = 44;         ///< film: sums, tests, image, cost
+  /// The film at its peak, per pixel: the progressive state (colour sum 12 bytes, tests 8,
+  /// auxiliary sums 40: render.h's FilmState and PixelAov), either the pass's copy of it (60)
+  /// while rendering or the outputs (image 12, cost 8, tests 8, depth 4, level 4, normal 12,
+  /// albedo 12) after, plus a checkpoint being written (60, its bytes).
+  static constexpr std::uint64_t kPerPixel = 180;
   /// Bytes a scene file of `triangles` triangles built explicitly (loose or expanded), plus
   /// `instances` placements of instanced meshes of `instanced_triangles` in all, takes.
   static constexpr std::uint64_t scene(std::uint64_t triangles, std::uint64_t instanced_triangles,
@@ -40,6 +44,7 @@ struct BuildConfig {
   int bins = 16;      ///< SAH bins per axis
   bool parallel = true;
   BakeConfig bake;
+  double* bake_seconds = nullptr;  ///< when set, the bakes' wall time is added to it
 };
 
 /// Builds a hierarchy over `prims` with a binned SAH, collapsed to `arity`-wide nodes, in

@@ -1,0 +1,39 @@
+#pragma once
+/// \file The files `amalgam render` writes besides the stats JSON (docs/outputs.md): the
+/// multi-layer float32 OpenEXR, the cost image with its colour bar, the rendered-level image.
+/// Every writer is atomic and throws ImageIoError naming the file.
+
+#include <string>
+#include <vector>
+
+#include "amalgam/io/colormap.h"
+#include "amalgam/io/image.h"
+#include "amalgam/render/render.h"
+
+namespace amalgam {
+
+/// The channels of `write_render_exr`, in the order documented in docs/outputs.md.
+std::vector<std::string> render_exr_channels();
+
+/// Writes every output of `r` as float32 OpenEXR: R, G, B (the beauty, at the top level so
+/// RGB-only readers see it), cost.Y (intersection tests, total over the pixel's samples),
+/// level.Y, Z (depth), N.X, N.Y, N.Z (normal), albedo.R, albedo.G, albedo.B, with `attributes`
+/// as string attributes of the header. Returns the largest cost value written; totals above
+/// 2^24 are not exact in float32 (the caller warns).
+double write_render_exr(const std::string& path, const RenderOutput& r,
+                        const ImageText& attributes);
+
+/// The cost image: .png in viridis on the log scale of `range` (tests per primary sample, the
+/// mean over the pixel's samples) with a colour bar appended below (colormap.h) and the range
+/// as tEXt metadata; .pfm/.exr the raw mean tests per sample, grey.
+void write_cost_image(const std::string& path, const RenderOutput& r, const LogRange& range);
+
+/// The rendered-level image: .png in viridis from level 0 to `max_level` (linear), primitives
+/// light grey, nothing black; .pfm/.exr the raw level (kLevelPrimitive, kLevelNothing), grey.
+void write_level_image(const std::string& path, const RenderOutput& r, int max_level);
+
+/// Whether `path` names a PNG, or an OpenEXR file (by extension, any case).
+bool is_png_path(const std::string& path);
+bool is_exr_path(const std::string& path);
+
+}  // namespace amalgam
