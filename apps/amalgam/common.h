@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "amalgam/builtin/params.h"
+#include "amalgam/load/load_scene.h"
 #include "amalgam/math/vec.h"
 #include "amalgam/render/options.h"
 
@@ -25,12 +26,17 @@ struct CommonOptions {
   RenderOptions options;
   CLI::Option* level_option = nullptr;
   CLI::Option* footprint_option = nullptr;
+  std::string camera, eye, look_at, up, fov;  ///< the view options, as given
+  CameraChoice view;                          ///< set by finish()
 
   /// Registers SCENE, --set and the renderer options of CONTRACT.md on `app`.
   void add_to(CLI::App& app);
   /// Converts the parsed text into `options`; throws InputError on bad values.
   void finish();
   Params params() const;
+  /// Applies the view options to a loaded scene (choose_camera) and prints its warnings (what
+  /// it holds that is not rendered), one line each on stderr.
+  void prepare(LoadedScene& scene) const;
 };
 
 /// CLI11 validators with short messages of our own (CLI11's range messages print both bounds

@@ -165,7 +165,8 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   budget.max_bytes = limit - film;
   budget.limit_name = "--max-memory " + format_bytes(static_cast<double>(limit)) + " less " +
                       format_bytes(static_cast<double>(film)) + " for the film";
-  const LoadedScene scene = load_scene(common.scene, common.params(), budget);
+  LoadedScene scene = load_scene(common.scene, common.params(), budget);
+  common.prepare(scene);  // the view options, before the fingerprint takes the camera
   check_options(scene, o);
 
   const std::string fp = fingerprint(common, scene);
@@ -249,7 +250,8 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
 int run_trace(CommonOptions& common, const std::string& origin, const std::string& direction) {
   common.finish();
   set_activity("loading and building " + common.scene);
-  const LoadedScene scene = load_scene(common.scene, common.params());
+  LoadedScene scene = load_scene(common.scene, common.params());
+  common.prepare(scene);
   check_options(scene, common.options);
   Ray ray = scene.env.camera.centre_ray(common.options.width, common.options.height);
   if (!origin.empty() || !direction.empty()) {

@@ -145,7 +145,7 @@ class SceneParser {
     if (auto l = r_.find(root, "lights"))
       read_lights(*l);
     else
-      out_.env.lights = default_lights(bounds, out_.env.camera);
+      out_.env.lights = default_lights(bounds, out_.env.camera), out_.default_lights = true;
     return std::move(out_);
   }
 

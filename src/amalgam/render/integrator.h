@@ -55,7 +55,8 @@ class Integrator {
     }
     Vec3 end = env_.background;
     if (hit.kind == TraceHit::Kind::kPrimitive) {
-      end = direct(primary, hit.surf, hit.surf.normal, h_.surface(hit.id), key, shadow_stream);
+      end = direct(primary, hit.surf, hit.surf.normal, surface_at(h_, hit.id, hit.surf), key,
+                   shadow_stream);
     } else if (hit.kind == TraceHit::Kind::kAmalgam) {
       const Appearance app = h_.appearance(hit.id);
       end = shade(primary, hit.id, app, hit.surf, key, shadow_stream);

@@ -100,7 +100,7 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
     if (!best) continue;
     ++hits;
     const Surface& m = h.materials[h.prims[best_prim].material];
-    colour += m.colour;
+    colour += h.mean_colour(m);  // a texture's mean over its texels
     spec += m.reflectance;
     shine += m.shininess;
     normals.add(best->normal, 1.0f);
