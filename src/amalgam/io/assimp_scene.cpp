@@ -137,7 +137,17 @@ bool load_texture(const aiScene& scene, const std::string& path, const std::stri
     why = "no such embedded texture";
     return false;
   }
-  fs::path file = fs::path(ref).is_absolute() ? fs::path(ref) : fs::path(path).parent_path() / ref;
+  // As written; with Windows separators turned round (".\\tex.jpg" in many OBJ files); and
+  // the file name alone, beside the mesh.
+  const fs::path dir = fs::path(path).parent_path();
+  std::string slashed = ref;
+  std::replace(slashed.begin(), slashed.end(), '\\', '/');
+  fs::path file;
+  for (const fs::path& p : {fs::path(ref), fs::path(slashed), fs::path(slashed).filename()}) {
+    file = p.is_absolute() ? p : dir / p;
+    std::error_code ec;
+    if (fs::is_regular_file(file, ec)) break;
+  }
   std::vector<std::uint8_t> bytes;
   if (!read_bytes(file, std::uintmax_t{1} << 30, bytes, why)) return false;
   return decode_image(bytes.data(), bytes.size(), max_texels, side, t, why);

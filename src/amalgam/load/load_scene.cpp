@@ -21,12 +21,15 @@ AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config) {
                           std::move(textures));
   std::vector<ExplicitHierarchy> meshes;
   meshes.reserve(d.meshes.size() + 1);
-  for (std::vector<Primitive>& m : d.meshes)
-    meshes.push_back(build_explicit(std::move(m), d.materials, config));
+  for (std::size_t i = 0; i < d.meshes.size(); ++i)
+    meshes.push_back(build_explicit(
+        std::move(d.meshes[i]), d.materials, config,
+        i < d.mesh_uvs.size() ? std::move(d.mesh_uvs[i]) : std::vector<TexCoords>{}, textures));
   if (!d.prims.empty()) {
     Instance loose;  // identity: traced bit-exactly as in an explicit hierarchy
     loose.mesh = static_cast<std::uint32_t>(meshes.size());
-    meshes.push_back(build_explicit(std::move(d.prims), d.materials, config));
+    meshes.push_back(
+        build_explicit(std::move(d.prims), d.materials, config, std::move(d.uvs), textures));
     d.instances.push_back(loose);
   }
   return build_instanced(std::move(meshes), std::move(d.instances), config);

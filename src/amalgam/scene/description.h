@@ -35,6 +35,7 @@ struct SceneDescription {
   /// Empty unless the scene is large enough to keep instances (see SceneFileConfig,
   /// io/scene_json.h).
   std::vector<std::vector<Primitive>> meshes;
+  std::vector<std::vector<TexCoords>> mesh_uvs;  ///< per mesh: as `uvs`, for its primitives
   std::vector<Instance> instances;
 };
 
