@@ -182,15 +182,15 @@ void read_cameras_lights(const aiScene& scene, const std::string& path, bool glt
     const std::string name = quoted(c->mName);
     const aiNode* node = scene.mRootNode ? scene.mRootNode->FindNode(c->mName) : nullptr;
     if (!gltf) {
-      notes.add("cameras are read from glTF files only; not used", name);
+      notes.add("cameras not used (they are read from glTF files only)", name);
       continue;
     }
     if (c->mHorizontalFOV == 0.0f || c->mOrthographicWidth > 0.0f) {
-      notes.add("orthographic cameras are not supported; not used", name);
+      notes.add("orthographic cameras not supported, not used", name);
       continue;
     }
     if (node == nullptr) {
-      notes.add("cameras placed by no node; not used", name);
+      notes.add("cameras placed by no node, not used", name);
       continue;
     }
     // Assimp 5.2's glTF 2 importer stores yfov * aspectRatio as the horizontal field of view
@@ -207,7 +207,7 @@ void read_cameras_lights(const aiScene& scene, const std::string& path, bool glt
     if (!(cam.vfov_deg > 0.0f && cam.vfov_deg < 180.0f) || !finite(cam.position) || !finite(dir) ||
         !(length(dir) > 0.0f) || !finite(up) ||
         !(length(cross(dir, up)) > 1e-6f * length(dir) * length(up))) {
-      notes.add("cameras with a degenerate transform or field of view; not used", name);
+      notes.add("cameras with a degenerate transform or field of view, not used", name);
       continue;
     }
     cam.look_at = cam.position + normalize(dir) * scale;
@@ -219,7 +219,7 @@ void read_cameras_lights(const aiScene& scene, const std::string& path, bool glt
     if (l == nullptr) continue;
     const std::string name = quoted(l->mName);
     if (l->mType != aiLightSource_POINT && l->mType != aiLightSource_DIRECTIONAL) {
-      notes.add(std::string(light_kind(l->mType)) + " lights are not supported; not used", name);
+      notes.add(std::string(light_kind(l->mType)) + " lights not supported, not used", name);
       continue;
     }
     const aiNode* node = scene.mRootNode ? scene.mRootNode->FindNode(l->mName) : nullptr;
@@ -230,9 +230,9 @@ void read_cameras_lights(const aiScene& scene, const std::string& path, bool glt
       light.kind = LightKind::kPoint;
       light.position = point(g, l->mPosition);
       if (l->mAttenuationConstant != 0.0f || l->mAttenuationLinear != 0.0f)
-        notes.add("light falloff other than inverse-square is rendered as inverse-square", name);
+        notes.add("light falloff rendered as inverse-square instead of the file's, lights", name);
       if (node && node->mMetaData && node->mMetaData->HasKey("PBR_LightRange"))
-        notes.add("light ranges are ignored (inverse-square falloff without cut-off)", name);
+        notes.add("light ranges ignored (inverse-square falloff without cut-off), lights", name);
     } else {
       light.kind = LightKind::kDirectional;
       const Vec3 d = vector(g, l->mDirection);
@@ -240,7 +240,7 @@ void read_cameras_lights(const aiScene& scene, const std::string& path, bool glt
     }
     if (!finite(light.position) || !finite(light.intensity) || light.direction == Vec3{} ||
         std::min({light.intensity.x, light.intensity.y, light.intensity.z}) < 0.0f) {
-      notes.add("lights with a degenerate transform or a negative intensity; not used", name);
+      notes.add("lights with a degenerate transform or a negative intensity, not used", name);
       continue;
     }
     out.lights.push_back(light);
@@ -259,28 +259,28 @@ void note_unrendered(const aiScene& scene, const std::string& path, ImportedMesh
     if ((m->Get(AI_MATKEY_COLOR_EMISSIVE, c) == aiReturn_SUCCESS && c.r + c.g + c.b > 0.0f) ||
         m->GetTextureCount(aiTextureType_EMISSIVE) > 0 ||
         m->GetTextureCount(aiTextureType_EMISSION_COLOR) > 0)
-      notes.add("emission is not rendered (materials)", name);
+      notes.add("emission not rendered, materials", name);
     if (m->Get(AI_MATKEY_TRANSMISSION_FACTOR, f) == aiReturn_SUCCESS && f > 0.0f)
-      notes.add("transmission is not rendered (materials)", name);
+      notes.add("transmission not rendered, materials", name);
     if (m->Get(AI_MATKEY_CLEARCOAT_FACTOR, f) == aiReturn_SUCCESS && f > 0.0f)
-      notes.add("clearcoat is not rendered (materials)", name);
+      notes.add("clearcoat not rendered, materials", name);
     if (m->Get(AI_MATKEY_SHEEN_COLOR_FACTOR, c) == aiReturn_SUCCESS)
-      notes.add("sheen is not rendered (materials)", name);
+      notes.add("sheen not rendered, materials", name);
     if (m->Get(AI_MATKEY_VOLUME_THICKNESS_FACTOR, f) == aiReturn_SUCCESS && f > 0.0f)
-      notes.add("volumes are not rendered (materials)", name);
+      notes.add("volumes not rendered, materials", name);
     aiString mode;
     if ((m->Get(AI_MATKEY_GLTF_ALPHAMODE, mode) == aiReturn_SUCCESS &&
          std::string(mode.C_Str()) != "OPAQUE") ||
         (m->Get(AI_MATKEY_OPACITY, f) == aiReturn_SUCCESS && f < 1.0f))
-      notes.add("transparency is not rendered: opaque (materials)", name);
+      notes.add("transparency not rendered (drawn opaque), materials", name);
     int shading = 0;
     if (m->Get(AI_MATKEY_SHADING_MODEL, shading) == aiReturn_SUCCESS) {
       if (shading == aiShadingMode_Unlit)
-        notes.add("unlit materials are shaded as lit (materials)", name);
+        notes.add("unlit materials shaded as lit", name);
       else if (shading != aiShadingMode_Flat && shading != aiShadingMode_Gouraud &&
                shading != aiShadingMode_Phong && shading != aiShadingMode_Blinn &&
                shading != aiShadingMode_PBR_BRDF)
-        notes.add("shading models other than Phong or PBR are rendered as Lambertian (materials)",
+        notes.add("shading models other than Phong or PBR rendered as Lambertian, materials",
                   name);
     }
     const std::pair<aiTextureType, const char*> unused[] = {
@@ -297,24 +297,24 @@ void note_unrendered(const aiScene& scene, const std::string& path, ImportedMesh
     };
     for (const auto& [type, what] : unused)
       if (m->GetTextureCount(type) > 0)
-        notes.add(std::string(what) + " textures are not used (materials)", name);
+        notes.add(std::string(what) + " textures not used, materials", name);
     for (aiTextureType t : {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE}) {
       aiUVTransform tr;
       if (m->GetTextureCount(t) > 0 && m->Get(AI_MATKEY_UVTRANSFORM(t, 0), tr) == aiReturn_SUCCESS)
-        notes.add("texture transforms are ignored (materials)", name);
+        notes.add("texture transforms ignored, materials", name);
     }
   }
   for (unsigned i = 0; i < scene.mNumMeshes; ++i) {
     const aiMesh* m = scene.mMeshes[i];
     if (m == nullptr) continue;
     const std::string name = m->mName.length ? quoted(m->mName) : numbered(i);
-    if (m->HasVertexColors(0)) notes.add("vertex colours are ignored (meshes)", name);
-    if (m->mNumBones > 0) notes.add("skins are ignored: rest pose (meshes)", name);
-    if (m->mNumAnimMeshes > 0) notes.add("morph targets are ignored (meshes)", name);
+    if (m->HasVertexColors(0)) notes.add("vertex colours ignored, meshes", name);
+    if (m->mNumBones > 0) notes.add("skins ignored (rest pose), meshes", name);
+    if (m->mNumAnimMeshes > 0) notes.add("morph targets ignored, meshes", name);
   }
   for (unsigned i = 0; i < scene.mNumAnimations; ++i) {
     const aiAnimation* a = scene.mAnimations[i];
-    notes.add("animations are ignored: rest pose",
+    notes.add("animations ignored (rest pose)",
               a && a->mName.length ? quoted(a->mName) : numbered(i));
   }
   notes.flush(out.dropped);
@@ -368,7 +368,7 @@ std::vector<unsigned> read_materials(const aiScene& scene, const std::string& pa
             out.textures.push_back(std::move(t));
           } else {
             notes.add("textures that cannot be read (" + one_line(why, 200) +
-                          ") are replaced by their material's colour",
+                          "), rendered with their material's colour",
                       quoted(ref));
           }
           it = loaded.emplace(key, index).first;
