@@ -24,10 +24,9 @@ namespace {
 namespace fs = std::filesystem;
 const fs::path kGltf = "/usr/share/assimp/models/glTF2";
 
-#define REQUIRE_MODELS()                 \
-  ASSERT_TRUE(fs::is_directory(kGltf))   \
-      << kGltf                           \
-      << " is missing: install Debian's assimp-testmodels package (scripts/deps.sh)"
+#define REQUIRE_MODELS()               \
+  ASSERT_TRUE(fs::is_directory(kGltf)) \
+      << kGltf << " is missing: install Debian's assimp-testmodels package (scripts/deps.sh)"
 
 /// A 2 x 1 texture: left texel `l`, right texel `r` (sRGB bytes).
 Texture two_texels(std::uint8_t l, std::uint8_t r, Wrap wrap = Wrap::kRepeat) {
@@ -188,7 +187,8 @@ TEST(Texture, ObjDiffuseMapsWithWindowsPathsAreRead) {
 }
 
 fs::path scratch_dir() {
-  const fs::path d = fs::temp_directory_path() / ("amalgam_scene_import_" + std::to_string(getpid()));
+  const fs::path d =
+      fs::temp_directory_path() / ("amalgam_scene_import_" + std::to_string(getpid()));
   fs::create_directories(d);
   return d;
 }
@@ -255,8 +255,7 @@ TEST(GltfCamera, ChooseCameraByNameIndexAndOverride) {
       choose_camera(s, {bad, {}, {}, {}, {}});
       ADD_FAILURE() << bad;
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("cameras: 0 'nodes[1]'"), std::string::npos)
-          << e.what();
+      EXPECT_NE(std::string(e.what()).find("cameras: 0 'nodes[1]'"), std::string::npos) << e.what();
     }
   }
   // The override is part of the content hash (so of a checkpoint's fingerprint).
@@ -266,7 +265,7 @@ TEST(GltfCamera, ChooseCameraByNameIndexAndOverride) {
   EXPECT_EQ(s.env.camera.look_at, file.look_at);
   EXPECT_NE(content_hash(s), h0);
   EXPECT_THROW(choose_camera(s, {"", {}, Vec3{0.5f, 0.5f, 5}, {}, {}}), InputError);  // at eye
-  EXPECT_THROW(choose_camera(s, {"", {}, {}, Vec3{0, 0, 1}, {}}), InputError);  // along view
+  EXPECT_THROW(choose_camera(s, {"", {}, {}, Vec3{0, 0, 1}, {}}), InputError);        // along view
   EXPECT_THROW(choose_camera(s, {"", {}, {}, {}, 180.0f}), InputError);
 }
 
@@ -330,9 +329,8 @@ TEST(GltfLights, SkinsAndAnimationsWarnOnceEach) {
   const SceneDescription d = mesh_scene((kGltf / "simple_skin/simple_skin.gltf").string());
   ASSERT_EQ(d.warnings.size(), 2u);
   const auto has = [&](const char* what) {
-    return std::count_if(d.warnings.begin(), d.warnings.end(), [&](const std::string& w) {
-      return w.find(what) != std::string::npos;
-    });
+    return std::count_if(d.warnings.begin(), d.warnings.end(),
+                         [&](const std::string& w) { return w.find(what) != std::string::npos; });
   };
   EXPECT_EQ(has("skins ignored"), 1);
   EXPECT_EQ(has("animations ignored"), 1);
