@@ -280,8 +280,7 @@ void note_unrendered(const aiScene& scene, const std::string& path, ImportedMesh
       else if (shading != aiShadingMode_Flat && shading != aiShadingMode_Gouraud &&
                shading != aiShadingMode_Phong && shading != aiShadingMode_Blinn &&
                shading != aiShadingMode_PBR_BRDF)
-        notes.add("shading models other than Phong or PBR rendered as Lambertian, materials",
-                  name);
+        notes.add("shading models other than Phong or PBR rendered as Lambertian, materials", name);
     }
     const std::pair<aiTextureType, const char*> unused[] = {
         {aiTextureType_NORMALS, "normal"},
@@ -347,6 +346,22 @@ std::vector<unsigned> read_materials(const aiScene& scene, const std::string& pa
       if ((!sg && m->Get(AI_MATKEY_BASE_COLOR, c) == aiReturn_SUCCESS) ||
           m->Get(AI_MATKEY_COLOR_DIFFUSE, c) == aiReturn_SUCCESS)
         s.colour = {clamp01(c.r), clamp01(c.g), clamp01(c.b)};
+      // Phong materials (OBJ's Ks and Ns): the specular lobe's weight and exponent.
+      int shading = 0;
+      aiColor4D ks;
+      float ns = 0.0f, strength = 1.0f;
+      if (m->Get(AI_MATKEY_SHADING_MODEL, shading) == aiReturn_SUCCESS &&
+          (shading == aiShadingMode_Phong || shading == aiShadingMode_Blinn) &&
+          m->Get(AI_MATKEY_COLOR_SPECULAR, ks) == aiReturn_SUCCESS &&
+          m->Get(AI_MATKEY_SHININESS, ns) == aiReturn_SUCCESS && ns > 0.0f) {
+        m->Get(AI_MATKEY_SHININESS_STRENGTH, strength);
+        const float top = std::max({ks.r, ks.g, ks.b}), low = std::min({ks.r, ks.g, ks.b});
+        s.reflectance = clamp01(top * strength);
+        s.shininess = std::isfinite(ns) ? std::clamp(ns, 1.0f, 1e4f) : 32.0f;
+        if (s.reflectance > 0.0f && top - low > 0.01f * top)
+          notes.add("coloured specular rendered grey (its largest component), materials",
+                    material_name(*m, i));
+      }
       aiString ref;
       aiTextureType type = aiTextureType_BASE_COLOR;
       if ((!sg && m->GetTexture(type, 0, &ref, nullptr, &uv) == aiReturn_SUCCESS) ||
