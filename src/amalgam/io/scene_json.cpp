@@ -97,7 +97,11 @@ class SceneParser {
       std::set<const MeshEntry*> seen;
       for (const Placement& p : placements)
         if (!p.expand && seen.insert(p.mesh).second) instanced += p.mesh->mesh->triangles.size();
-      check_memory(r_.file(), MemoryModel::scene(total, instanced, kept), config_);
+      std::uint64_t textures = 0;  // texels once per file; coordinates as read and as built
+      for (const auto& [file, mesh] : imported_)
+        for (const Texture& t : mesh->textures) textures += t.texels.size();
+      if (textures) textures += 2 * sizeof(TexCoords) * (total + instanced);
+      check_memory(r_.file(), MemoryModel::scene(total, instanced, kept) + textures, config_);
     }
     out_.prims.reserve(total);
     out_.instances.reserve(kept);
