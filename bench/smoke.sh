@@ -37,5 +37,5 @@ awk '
 cp "$root/README.md" "$root/docs/benchmarks.md" "$out/"
 python3 "$root/scripts/bench_report.py" "$out/embree.json" "$out/embree.log" \
   "$out/field/results.json" "$out/benchmarks.md" "$out/README.md" >/dev/null
-grep -q 'target (issue 5)' "$out/README.md"
+grep -q '| target | measured |' "$out/README.md"
 echo "bench smoke: ok"

@@ -8,7 +8,7 @@ packages=(
   libgtest-dev libbenchmark-dev
   libassimp-dev assimp-testmodels
   libembree-dev
-  gnuplot-nox python3 qemu-user
+  gnuplot-nox python3 python3-matplotlib python3-numpy qemu-user
 )
 missing=()
 for p in "${packages[@]}"; do

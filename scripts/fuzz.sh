@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fuzzing (issue 6): builds the libFuzzer targets (CMake preset `fuzz`, clang-14, with ASan +
+# Fuzzing: builds the libFuzzer targets (CMake preset `fuzz`, clang-14, with ASan +
 # UBSan) and runs each one for a fixed time with a fixed seed, starting from the committed seed
 # corpus in fuzz/corpus/<target>/. Fails on any crash, sanitizer report, leak, timeout or
 # out-of-memory; the offending input is kept in build-fuzz/artifacts/.

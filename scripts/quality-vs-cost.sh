@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Quality vs cost of amalgams on a real-mesh field (issue 4, item 6).
+# Quality vs cost of amalgams on a real-mesh field.
 #
 #   scripts/quality-vs-cost.sh           full study (about 3-6 minutes on 2 cores): writes
 #                                        docs/quality-vs-cost/{results.csv, *.png} and the

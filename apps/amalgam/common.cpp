@@ -12,10 +12,11 @@ namespace amalgam::cli {
 void CommonOptions::add_to(CLI::App& app) {
   app.add_option("scene", scene, "builtin:NAME, a scene .json or a mesh file")->required();
   app.add_option("--set", sets, "builtin scene parameter key=value (repeatable)");
-  app.add_option("--renderer", renderer, "scale-sensitive (default) or traditional")
-      ->check(CLI::IsMember({"scale-sensitive", "traditional"}));
-  app.add_option("--opacity", opacity, "stochastic (default) or deterministic")
-      ->check(CLI::IsMember({"stochastic", "deterministic"}));
+  renderer_option =
+      app.add_option("--renderer", renderer, "scale-sensitive (default) or traditional")
+          ->check(CLI::IsMember({"scale-sensitive", "traditional"}));
+  opacity_option = app.add_option("--opacity", opacity, "stochastic (default) or deterministic")
+                       ->check(CLI::IsMember({"stochastic", "deterministic"}));
   level_option =
       app.add_option("--level", level, "scale-sensitive: render the amalgams met on level L")
           ->check(non_negative_int());
@@ -34,8 +35,13 @@ void CommonOptions::add_to(CLI::App& app) {
                 return "expected a number > 0";
               },
               "K > 0"));
-  app.add_option("--order", order, "sorted (default): nearest child first; unsorted: stored order")
-      ->check(CLI::IsMember({"sorted", "unsorted"}));
+  order_option = app.add_option("--order", order,
+                                "sorted (default): nearest child first; unsorted: stored order")
+                     ->check(CLI::IsMember({"sorted", "unsorted"}));
+  app.add_option("--tracer", tracer,
+                 "amalgam (default) or embree: Intel Embree 3 at full detail, same shading "
+                 "(docs/embree.md)")
+      ->check(CLI::IsMember({"amalgam", "embree"}));
   app.add_option("--seed", seed, "seed of all randomness, 0 .. 2^64-1 (default 0)");
   app.add_option("--threads", threads, "worker threads (default: all cores)")
       ->check(non_negative_int());
@@ -49,6 +55,9 @@ void CommonOptions::add_to(CLI::App& app) {
 
 void CommonOptions::prepare(LoadedScene& scene) const {
   choose_camera(scene, view);
+}
+
+void print_warnings(const LoadedScene& scene) {
   for (const std::string& w : scene.warnings) std::cerr << "amalgam: warning: " << w << "\n";
 }
 
@@ -62,6 +71,27 @@ void CommonOptions::finish() {
                      (level_given ? "--level" : "--footprint") + " does not apply");
   options.renderer =
       renderer == "traditional" ? RendererKind::kTraditional : RendererKind::kScaleSensitive;
+  options.tracer = tracer == "embree" ? TracerKind::kEmbree : TracerKind::kAmalgam;
+  if (options.tracer == TracerKind::kEmbree) {
+#if !defined(AMALGAM_HAVE_EMBREE)
+    throw InputError(
+        "--tracer embree: this amalgam was built without Embree (install libembree-dev, "
+        "reconfigure with -DAMALGAM_EMBREE=ON)");
+#endif
+    // Embree renders every primitive (full detail): the options that choose amalgams, blend
+    // them or order amalgam's own traversal have no meaning there.
+    auto refuse = [](const std::string& what) {
+      throw InputError("--tracer embree renders at full detail: " + what + " does not apply");
+    };
+    if (renderer_option && renderer_option->count() > 0 && renderer != "traditional")
+      refuse("--renderer " + renderer);
+    if (level_given) refuse("--level");
+    if (footprint_given) refuse("--footprint");
+    if (opacity_option && opacity_option->count() > 0 && opacity != "stochastic")
+      refuse("--opacity " + opacity);
+    if (order_option && order_option->count() > 0) refuse("--order (Embree orders its own)");
+    options.renderer = RendererKind::kTraditional;
+  }
   options.opacity =
       opacity == "deterministic" ? OpacityKind::kDeterministic : OpacityKind::kStochastic;
   options.sorted = order == "sorted";

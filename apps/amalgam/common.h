@@ -23,19 +23,23 @@ struct CommonOptions {
   float footprint = 1.0f;
   std::string seed = "0";
   int threads = 0;
+  std::string tracer = "amalgam";
   RenderOptions options;
   CLI::Option* level_option = nullptr;
   CLI::Option* footprint_option = nullptr;
+  CLI::Option* renderer_option = nullptr;
+  CLI::Option* opacity_option = nullptr;
+  CLI::Option* order_option = nullptr;
   std::string camera, eye, look_at, up, fov;  ///< the view options, as given
   CameraChoice view;                          ///< set by finish()
 
   /// Registers SCENE, --set and the renderer options of CONTRACT.md on `app`.
   void add_to(CLI::App& app);
-  /// Converts the parsed text into `options`; throws InputError on bad values.
+  /// Converts the parsed text into `options`; throws InputError on bad values, and on options
+  /// --tracer embree cannot honour (it renders at full detail) or a build without Embree.
   void finish();
   Params params() const;
-  /// Applies the view options to a loaded scene (choose_camera) and prints its warnings (what
-  /// it holds that is not rendered), one line each on stderr.
+  /// Applies the view options to a loaded scene (choose_camera).
   void prepare(LoadedScene& scene) const;
 };
 
@@ -56,6 +60,10 @@ std::uint64_t parse_bytes(const std::string& text, const std::string& option);
 /// scene.json", "rendering", ...). Set by the subcommands as they go.
 void set_activity(std::string what);
 const std::string& activity();
+
+/// Prints what a loaded scene holds that is not rendered, one line each on stderr
+/// ("amalgam: warning: ...").
+void print_warnings(const LoadedScene& scene);
 
 /// Parses "x,y,z" into three floats; throws InputError naming the option.
 Vec3 parse_vec3(const std::string& text, const std::string& option);

@@ -88,6 +88,13 @@ int main(int argc, char** argv) {
   trace_opts.add_to(*trace);
   trace->add_option("--origin", origin, "ray origin x,y,z");
   trace->add_option("--direction", direction, "ray direction x,y,z");
+  // The ray's footprint (its cone spread) is that of a pixel of a width x height image.
+  trace
+      ->add_option("--width", trace_opts.options.width,
+                   "image width the ray's footprint is of (default 512)")
+      ->check(cli::positive_int());
+  trace->add_option("--height", trace_opts.options.height, "image height (default 512)")
+      ->check(cli::positive_int());
 
   app.add_subcommand("scenes", "list the builtin scenes and their parameters");
 

@@ -18,8 +18,12 @@
 #include "amalgam/io/stats_json.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
+#if defined(AMALGAM_HAVE_EMBREE)
+#include "amalgam/render/embree_tracer.h"
+#endif
 #include "amalgam/util/atomic_file.h"
 #include "common.h"
+#include "progress.h"
 
 namespace amalgam::cli {
 
@@ -57,12 +61,16 @@ std::string fingerprint(const CommonOptions& c, const LoadedScene& scene) {
     f << " --level " << *o.level;
   else
     f << " --footprint " << o.footprint;
+  if (o.tracer == TracerKind::kEmbree) f << " --tracer embree";  // amalgam's: as before
   return f.str();
 }
 
 /// Checks every output path before any work: an image path must name a format we write, every
 /// path must be writable, and no two outputs may be the same file. Throws InputError.
-void check_outputs(const RenderExtras& e, const std::string& ckpt) {
+void check_outputs(const RenderExtras& e, const std::string& ckpt, const RenderOptions& ro) {
+  if (!e.cost_image.empty() && ro.tracer == TracerKind::kEmbree)
+    throw InputError("--cost-image " + e.cost_image +
+                     ": --tracer embree counts no intersection tests (no cost image)");
   if (!is_image_path(e.out))
     throw InputError("--out " + e.out + ": unsupported image format (expected .png, .exr or .pfm)");
   if (!e.cost_image.empty() && !is_image_path(e.cost_image))
@@ -102,33 +110,6 @@ std::uint64_t film_bytes(const RenderOptions& o) {
   return MemoryModel::kProcess + pixels * MemoryModel::kPerPixel;
 }
 
-/// A one-line progress bar with ETA on stderr, shown only on a terminal, after one second.
-class Progress {
- public:
-  Progress(int total, bool enabled) : total_(total), enabled_(enabled && isatty(2)) {}
-  void update(int done) {
-    if (!enabled_) return;
-    const double t = std::chrono::duration<double>(clock::now() - start_).count();
-    if (t < 1.0 || done <= 0) return;
-    const double eta = t / done * (total_ - done);
-    const int width = 30, fill = static_cast<int>(width * static_cast<double>(done) / total_);
-    std::fprintf(stderr, "\r[%s%s] %3d%% %d/%d spp, %.1f s, ETA %.1f s ",
-                 std::string(fill, '#').c_str(), std::string(width - fill, ' ').c_str(),
-                 100 * done / total_, done, total_, t, eta);
-    shown_ = true;
-  }
-  ~Progress() {
-    if (shown_) std::fprintf(stderr, "\n");
-  }
-
- private:
-  using clock = std::chrono::steady_clock;
-  int total_;
-  bool enabled_;
-  bool shown_ = false;
-  clock::time_point start_ = clock::now();
-};
-
 void write_cost_image(const std::string& path, const RenderOutput& r) {
   const std::string ext = path.substr(path.find_last_of('.') + 1);
   if (ext == "png" || ext == "PNG") {
@@ -149,7 +130,7 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   common.finish();
   const RenderOptions& o = common.options;
   const std::string ckpt = extra.checkpoint.empty() ? extra.out + ".ckpt" : extra.checkpoint;
-  check_outputs(extra, ckpt);
+  check_outputs(extra, ckpt, o);
   const std::uint64_t asked =
       extra.max_memory.empty() ? 0 : parse_bytes(extra.max_memory, "--max-memory");
   if (!extra.max_memory.empty() && asked == 0)
@@ -161,13 +142,29 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
                      std::to_string(o.height) + ": the film needs " + format_bytes(film) +
                      ", more than --max-memory " + format_bytes(limit));
   set_activity("loading and building " + common.scene);
+  PhaseStatus status(!extra.quiet);
   SceneFileConfig budget;  // checked before the scene is built (MemoryModel)
   budget.max_bytes = limit - film;
   budget.limit_name = "--max-memory " + format_bytes(static_cast<double>(limit)) + " less " +
                       format_bytes(static_cast<double>(film)) + " for the film";
+  budget.on_phase = [&](const std::string& what) {
+    set_activity(what);
+    status.phase(what);
+  };
   LoadedScene scene = load_scene(common.scene, common.params(), budget);
   common.prepare(scene);  // the view options, before the fingerprint takes the camera
   check_options(scene, o);
+  const bool embree = o.tracer == TracerKind::kEmbree;
+#if defined(AMALGAM_HAVE_EMBREE)
+  std::unique_ptr<EmbreeScene> embree_scene;
+  if (embree) {
+    set_activity("building Embree's BVH of " + common.scene);
+    status.phase(activity());
+    embree_scene = std::make_unique<EmbreeScene>(scene, o.threads);
+  }
+#endif
+  status.stop();
+  print_warnings(scene);  // after the load phases' status line
 
   const std::string fp = fingerprint(common, scene);
   FilmState state;
@@ -199,7 +196,15 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
     }
   };
   set_activity("rendering " + common.scene);
-  RenderOutput r = render(scene, o, &state, control);
+#if defined(AMALGAM_HAVE_EMBREE)
+  RenderOutput r =
+      embree ? render_embree(*embree_scene, o, &state, control) : render(scene, o, &state, control);
+  const double embree_build = embree ? embree_scene->build_seconds() : 0.0;
+#else
+  RenderOutput r = render(scene, o, &state, control);  // finish() refused --tracer embree
+  const double embree_build = 0.0;
+#endif
+  progress.finish();
   set_activity("writing the outputs of " + common.scene);
   // The work is done: writing its results wins over further signals (on_signal).
   g_finishing.store(true);
@@ -220,7 +225,7 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
       attempt(extra.cost_image, [&] { write_cost_image(extra.cost_image, r); });
   }
   const std::string json =
-      stats_json(scene, o, r.counters, r.per_primary, r.seconds).dump(2) + "\n";
+      stats_json(scene, o, r.counters, r.per_primary, r.seconds, embree_build).dump(2) + "\n";
   if (!extra.stats.empty()) attempt(extra.stats, [&] { write_file_atomic(extra.stats, json); });
   if (r.interrupted || !failed.empty()) attempt(ckpt, [&] { write_checkpoint(ckpt, fp, state); });
   if (!failed.empty()) {
@@ -240,10 +245,14 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   }
   std::error_code ec;
   std::filesystem::remove(ckpt, ec);  // complete: the checkpoint is no longer needed
-  if (!extra.quiet)
+  if (!extra.quiet) {
     std::cerr << "amalgam: wrote " << extra.out << " (" << r.width << "x" << r.height << ", "
-              << r.spp << " spp, " << r.seconds << " s, " << r.per_primary.mean()
-              << " tests per primary ray)\n";
+              << r.spp << " spp, " << r.seconds << " s, ";
+    if (embree)
+      std::cerr << "Embree, BVH build " << embree_build << " s)\n";
+    else
+      std::cerr << r.per_primary.mean() << " tests per primary ray)\n";
+  }
   return 0;
 }
 
@@ -252,6 +261,7 @@ int run_trace(CommonOptions& common, const std::string& origin, const std::strin
   set_activity("loading and building " + common.scene);
   LoadedScene scene = load_scene(common.scene, common.params());
   common.prepare(scene);
+  print_warnings(scene);
   check_options(scene, common.options);
   Ray ray = scene.env.camera.centre_ray(common.options.width, common.options.height);
   if (!origin.empty() || !direction.empty()) {
@@ -262,10 +272,25 @@ int run_trace(CommonOptions& common, const std::string& origin, const std::strin
     ray = Ray::make(o, normalize(d));
     ray.cone_spread = spread;
   }
+  const bool embree = common.options.tracer == TracerKind::kEmbree;
+  double embree_build = 0.0;
+#if defined(AMALGAM_HAVE_EMBREE)
+  std::unique_ptr<EmbreeScene> embree_scene;
+  if (embree) {
+    embree_scene = std::make_unique<EmbreeScene>(scene, common.options.threads);
+    embree_build = embree_scene->build_seconds();
+  }
+#endif
   const auto t0 = std::chrono::steady_clock::now();
-  const TraceOutput t = trace(scene, common.options, ray);
+#if defined(AMALGAM_HAVE_EMBREE)
+  const TraceOutput t =
+      embree ? trace_embree(*embree_scene, common.options, ray) : trace(scene, common.options, ray);
+#else
+  const TraceOutput t = trace(scene, common.options, ray);  // finish() refused --tracer embree
+#endif
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  nlohmann::json j = stats_json(scene, common.options, t.counters, t.per_primary, secs);
+  nlohmann::json j =
+      stats_json(scene, common.options, t.counters, t.per_primary, secs, embree_build);
   if (t.hit.kind == TraceHit::Kind::kNone) {
     j["hit"] = nullptr;
   } else {
@@ -273,7 +298,7 @@ int run_trace(CommonOptions& common, const std::string& origin, const std::strin
                 {"object",
                  {{"kind", t.hit.kind == TraceHit::Kind::kPrimitive ? "primitive" : "amalgam"},
                   {"id", t.hit.id},
-                  {"level", t.hit.level}}},
+                  {"level", embree ? nlohmann::json(nullptr) : nlohmann::json(t.hit.level)}}},
                 {"point", {t.hit.surf.p.x, t.hit.surf.p.y, t.hit.surf.p.z}}};
   }
   j["colour"] = {t.colour.x, t.colour.y, t.colour.z};

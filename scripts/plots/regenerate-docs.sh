@@ -1,6 +1,6 @@
 #!/bin/sh
 # Regenerates docs/paper-reproduction.md and its plots/CSVs under docs/img/reproduction/ by
-# running every experiment of issue 3 at full size (a few tens of seconds on 2 cores).
+# running every experiment of the paper at full size (a few tens of seconds on 2 cores).
 # Usage (from the repository root, after building): scripts/plots/regenerate-docs.sh [build/amalgam]
 set -eu
 bin=${1:-build/amalgam}

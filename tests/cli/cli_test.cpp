@@ -66,6 +66,23 @@ TEST(Cli, TraceLineTraditionalIsTheWorstCase) {
   EXPECT_TRUE(j["level"].is_null());
 }
 
+TEST(Cli, TraceFootprintIsThatOfAPixelOfWidthByHeight) {
+  auto trace = [](const std::string& size) {
+    const CliRun r = run("trace builtin:prisms" + size);
+    EXPECT_EQ(r.status, 0) << size;
+    return nlohmann::json::parse(r.out);
+  };
+  const auto by_default = trace(""), same = trace(" --width 512 --height 512");
+  EXPECT_EQ(by_default["tests"], same["tests"]);  // 512 x 512 is the default, as for render
+  EXPECT_EQ(by_default["hit"], same["hit"]);
+  // A pixel of a 16 x 16 image is wide: the ray stops at an amalgam above the primitives.
+  const auto coarse = trace(" --width 16 --height 16");
+  EXPECT_EQ(coarse["hit"]["object"]["kind"], "amalgam");
+  EXPECT_EQ(by_default["hit"]["object"]["kind"], "primitive");
+  EXPECT_LT(coarse["tests"]["total"].get<int>(), by_default["tests"]["total"].get<int>());
+  EXPECT_EQ(run("trace builtin:prisms --width 0").status, 2);
+}
+
 TEST(Cli, RenderWritesImageCostImageAndStats) {
   const fs::path d = temp_dir();
   const CliRun r =
@@ -383,6 +400,26 @@ std::string finish(FILE* p) {
 // The progress bar (with its ETA) appears on a terminal after a second, never on a pipe, and
 // --quiet turns it off on a terminal too (with the closing summary line). The three renders run
 // side by side, so each lasts the same (> 1 s: long enough for the bar to show).
+// On a terminal, a scene that takes a while to load shows what it is doing (reading, building and
+// baking), here at once (AMALGAM_PROGRESS_AFTER=0 instead of after a second); the line is ended
+// before the render's bar; not on a pipe.
+TEST(CliLimits, LoadPhasesShownOnATerminal) {
+  const fs::path d = temp_dir();
+  const std::string args = "AMALGAM_PROGRESS_AFTER=0 " + std::string(AMALGAM_BINARY) + " render " +
+                           AMALGAM_SOURCE_DIR +
+                           "/scenes/spider-field.json --width 32 --height 24 --spp 1 --out ";
+  ASSERT_EQ(std::system("command -v script >/dev/null 2>&1"), 0) << "script(1) (bsdutils) missing";
+  const std::string tty_out =
+      finish(start("script -qec '" + args + (d / "t.pfm").string() + "' /dev/null"));
+  const std::string plain_out = finish(start(args + (d / "p.pfm").string() + " 2>&1"));
+  EXPECT_NE(tty_out.find("building and baking"), std::string::npos) << tty_out;
+  const std::size_t wrote = tty_out.find("amalgam: wrote");
+  ASSERT_NE(wrote, std::string::npos) << tty_out;
+  EXPECT_LT(tty_out.rfind("building and baking"), wrote);
+  EXPECT_TRUE(wrote > 0 && tty_out[wrote - 1] == '\n') << tty_out;
+  EXPECT_EQ(plain_out.find("building and baking"), std::string::npos) << plain_out;
+}
+
 TEST(CliLimits, ProgressBarOnlyOnATerminal) {
   const fs::path d = temp_dir();
   const std::string args = std::string(AMALGAM_BINARY) +
@@ -400,6 +437,8 @@ TEST(CliLimits, ProgressBarOnlyOnATerminal) {
   EXPECT_NE(tty_out.find("ETA"), std::string::npos) << tty_out;
   EXPECT_NE(tty_out.find("spp"), std::string::npos) << tty_out;
   EXPECT_NE(tty_out.find("amalgam: wrote"), std::string::npos) << tty_out;
+  // The summary starts a line of its own, after the bar's line is ended.
+  EXPECT_NE(tty_out.find("\namalgam: wrote"), std::string::npos) << tty_out;
   // A terminal with --quiet: nothing at all, and the image is still written.
   EXPECT_EQ(quiet_out.find("ETA"), std::string::npos) << quiet_out;
   EXPECT_EQ(quiet_out.find("amalgam: wrote"), std::string::npos) << quiet_out;

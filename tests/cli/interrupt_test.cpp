@@ -243,4 +243,32 @@ TEST(CliInterrupt, ResumeRefusesOtherSettingsADamagedCheckpointAndAnEditedScene)
   EXPECT_EQ(run(srender + sres), 0) << "the same scene again is";
 }
 
+#if defined(AMALGAM_HAVE_EMBREE)
+TEST(CliInterrupt, EmbreeResumesItsOwnCheckpointButNotAmalgams) {
+  Dir d("embree");
+  const std::string out = (d.path / "run.pfm").string();
+  // --tracer embree on a smaller prisms (Embree lists every box: 2 million at depth 7).
+  std::string render = kRender;
+  render.replace(render.find("depth=7"), 7, "depth=5");
+  const std::string embree = render + " --tracer embree";
+  const pid_t pid = start(embree + " --spp 1000000 --out " + out, d.path / "err.txt");
+  ASSERT_TRUE(wait_for(out + ".ckpt", pid)) << slurp(d.path / "err.txt");
+  kill(pid, SIGINT);
+  ASSERT_EQ(finish(pid), 1) << slurp(d.path / "err.txt");
+  const int held = samples_held(slurp(d.path / "err.txt"));
+  ASSERT_GE(held, 1);
+  const std::string spp = " --spp " + std::to_string(held + 2);
+  // amalgam's tracer does not continue Embree's samples (the fingerprint names the tracer).
+  const fs::path e = d.path / "other.txt";
+  EXPECT_EQ(
+      finish(start(render + " --renderer traditional" + spp + " --out " + out + " --resume", e)),
+      2);
+  EXPECT_NE(slurp(e).find("different settings"), std::string::npos) << slurp(e);
+  const std::string ref = (d.path / "ref.pfm").string();
+  ASSERT_EQ(run(embree + spp + " --out " + ref), 0);
+  ASSERT_EQ(run(embree + spp + " --out " + out + " --resume"), 0);
+  EXPECT_EQ(slurp(out), slurp(ref)) << "resumed image differs";
+}
+#endif
+
 }  // namespace

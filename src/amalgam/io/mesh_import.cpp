@@ -42,6 +42,10 @@ std::string find_helper(const ImportConfig& config) {
     const fs::path beside = self.parent_path() / "amalgam-import";
     if (fs::is_regular_file(beside, ec)) return beside.string();
   }
+#ifdef AMALGAM_IMPORT_HELPER_INSTALL_PATH  // a program linked against an installed amalgam
+  if (fs::is_regular_file(AMALGAM_IMPORT_HELPER_INSTALL_PATH, ec))
+    return AMALGAM_IMPORT_HELPER_INSTALL_PATH;
+#endif
 #ifdef AMALGAM_IMPORT_HELPER_BUILD_PATH
   if (fs::is_regular_file(AMALGAM_IMPORT_HELPER_BUILD_PATH, ec))
     return AMALGAM_IMPORT_HELPER_BUILD_PATH;

@@ -3,6 +3,7 @@
 /// SceneDescription (scene/description.h); bare meshes are loaded by load/load_scene.h.
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "amalgam/scene/description.h"
@@ -29,6 +30,9 @@ struct SceneFileConfig {
   /// message (e.g. "--max-memory 100 MiB less the film").
   std::uint64_t max_bytes = 0;
   std::string limit_name = "the memory limit";
+  /// Called as loading enters each phase ("reading scene.json", "building and baking
+  /// scene.json"), e.g. for a status line or an out-of-memory message. Optional.
+  std::function<void(const std::string&)> on_phase;
 };
 
 /// "12.3 MiB": a byte count for messages.

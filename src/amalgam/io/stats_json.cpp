@@ -3,7 +3,8 @@
 namespace amalgam {
 
 nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, const Counters& c,
-                          const CostDistribution& d, double render_seconds) {
+                          const CostDistribution& d, double render_seconds,
+                          double embree_build_seconds) {
   using nlohmann::json;
   const HierarchyInfo info = scene.info();
   json j;
@@ -13,6 +14,8 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
   j["level"] = (ss && o.level) ? json(*o.level) : json(nullptr);
   j["footprint"] = (ss && !o.level) ? json(o.footprint) : json(nullptr);
   j["order"] = o.sorted ? "sorted" : "unsorted";
+  const bool embree = o.tracer == TracerKind::kEmbree;
+  j["tracer"] = embree ? "embree" : "amalgam";
   j["seed"] = o.seed;
   j["scene"] = {{"name", scene.name},
                 {"primitives", info.primitives},
@@ -36,6 +39,13 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
       {"mean", d.mean()}, {"p50", d.quantile(0.5)}, {"p99", d.quantile(0.99)}, {"max", d.max()}};
   j["time_s"] = {
       {"load", scene.load_seconds}, {"build", scene.build_seconds}, {"render", render_seconds}};
+  if (embree) {
+    j["opacity"] = nullptr;
+    j["order"] = nullptr;
+    j["tests"] = nullptr;
+    j["per_primary_ray"] = nullptr;
+    j["time_s"]["embree_build"] = embree_build_seconds;
+  }
   return j;
 }
 

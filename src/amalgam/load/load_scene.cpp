@@ -59,6 +59,7 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
 LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
+  if (config.on_phase) config.on_phase("reading " + path);
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -68,6 +69,7 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   std::vector<NamedCamera> cameras = std::move(d.cameras);
   std::vector<std::string> warnings = std::move(d.warnings);
   const bool defaults = d.default_lights;
+  if (config.on_phase) config.on_phase("building and baking " + path);
   AnyHierarchy h = build_hierarchy(std::move(d));
   const auto t2 = Clock::now();
   LoadedScene s{path, std::move(h), std::move(env)};

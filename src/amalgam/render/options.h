@@ -8,6 +8,9 @@ namespace amalgam {
 
 enum class RendererKind : std::uint8_t { kScaleSensitive, kTraditional };
 enum class OpacityKind : std::uint8_t { kStochastic, kDeterministic };
+/// What finds the hits: amalgam's traversal, or Intel Embree 3 at full detail
+/// (render/embree_tracer.h; only the traditional renderer).
+enum class TracerKind : std::uint8_t { kAmalgam, kEmbree };
 
 struct RenderOptions {
   RendererKind renderer = RendererKind::kScaleSensitive;
@@ -20,6 +23,7 @@ struct RenderOptions {
   int width = 512;
   int height = 512;
   int spp = 4;
+  TracerKind tracer = TracerKind::kAmalgam;
 };
 
 }  // namespace amalgam

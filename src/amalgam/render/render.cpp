@@ -16,6 +16,29 @@ void check_options(const LoadedScene& scene, const RenderOptions& o) {
   if (!(o.footprint > 0.0f)) throw InputError("--footprint: expected a number > 0");
   if (o.width < 1 || o.height < 1 || o.spp < 1)
     throw InputError("--width, --height and --spp must be at least 1");
+  if (o.tracer == TracerKind::kEmbree && o.renderer != RendererKind::kTraditional)
+    throw InputError("--tracer embree renders at full detail: only --renderer traditional");
+}
+
+namespace {
+void require_amalgam_tracer(const RenderOptions& o) {
+  if (o.tracer != TracerKind::kAmalgam)
+    throw InputError("--tracer embree: render with render_embree (render/embree_tracer.h)");
+}
+}  // namespace
+
+void start_film(FilmState& st, const RenderOptions& o) {
+  const std::size_t pixels = static_cast<std::size_t>(o.width) * o.height;
+  if (st.sum.empty()) {
+    st = FilmState{};
+    st.width = o.width;
+    st.height = o.height;
+    st.sum.assign(pixels, Vec3{});
+    st.tests.assign(pixels, 0);
+  }
+  if (st.width != o.width || st.height != o.height || st.sum.size() != pixels ||
+      st.spp_done > o.spp)
+    throw InputError("resume: the saved render does not match these options");
 }
 
 RenderOutput finish(const FilmState& st) {
@@ -38,20 +61,11 @@ RenderOutput finish(const FilmState& st) {
 RenderOutput render(const LoadedScene& scene, const RenderOptions& o, FilmState* resume,
                     const RenderControl& control) {
   check_options(scene, o);
+  require_amalgam_tracer(o);
   const auto t0 = std::chrono::steady_clock::now();
-  const std::size_t pixels = static_cast<std::size_t>(o.width) * o.height;
   FilmState local;
   FilmState& st = resume ? *resume : local;
-  if (st.sum.empty()) {
-    st = FilmState{};
-    st.width = o.width;
-    st.height = o.height;
-    st.sum.assign(pixels, Vec3{});
-    st.tests.assign(pixels, 0);
-  }
-  if (st.width != o.width || st.height != o.height || st.sum.size() != pixels ||
-      st.spp_done > o.spp)
-    throw InputError("resume: the saved render does not match these options");
+  start_film(st, o);
 
 #if defined(AMALGAM_BUILD_AVX2_COPY)
   const bool interrupted = active_simd() == Simd::kAvx2
@@ -68,6 +82,7 @@ RenderOutput render(const LoadedScene& scene, const RenderOptions& o, FilmState*
 
 TraceOutput trace(const LoadedScene& scene, const RenderOptions& o, const Ray& ray) {
   check_options(scene, o);
+  require_amalgam_tracer(o);
   TraceOutput out;
 #if defined(AMALGAM_BUILD_AVX2_COPY)
   if (active_simd() == Simd::kAvx2)

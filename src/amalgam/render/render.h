@@ -44,13 +44,18 @@ struct RenderControl {
   std::function<void(const FilmState&)> on_pass;
 };
 
-/// Renders the scene's camera view progressively, in passes of whole samples per pixel.
-/// Pixel (x, y), sample s uses the random stream hash(seed, y * width + x, s), and each
-/// pixel's samples are summed in sample order: the output is identical for any thread count,
-/// and a render resumed from a FilmState equals the uninterrupted one bit for bit.
-/// `resume` (optional) is the state to continue from and receives the final state.
+/// Renders the scene's camera view progressively with amalgam's traversal (options.tracer must
+/// be kAmalgam; Embree renders go through render_embree, render/embree_tracer.h), in passes of
+/// whole samples per pixel. Pixel (x, y), sample s uses the random stream hash(seed, y * width + x,
+/// s), and each pixel's samples are summed in sample order: the output is identical for any thread
+/// count, and a render resumed from a FilmState equals the uninterrupted one bit for bit. `resume`
+/// (optional) is the state to continue from and receives the final state.
 RenderOutput render(const LoadedScene& scene, const RenderOptions& options,
                     FilmState* resume = nullptr, const RenderControl& control = {});
+
+/// Prepares `st` for a render of `options`: a fresh film when it holds none, else checks that
+/// the saved one fits (InputError). Shared by `render` and `render_embree`.
+void start_film(FilmState& st, const RenderOptions& options);
 
 /// Converts accumulated state into an output (mean over the samples it holds).
 RenderOutput finish(const FilmState& state);
@@ -66,7 +71,8 @@ struct TraceOutput {
 /// Traces one primary ray with its shadow rays (random stream hash(seed, 0, 0)).
 TraceOutput trace(const LoadedScene& scene, const RenderOptions& options, const Ray& ray);
 
-/// Throws InputError when options do not fit the scene (e.g. --level beyond l_max).
+/// Throws InputError when options do not fit the scene (e.g. --level beyond l_max) or the
+/// tracer (Embree renders at full detail only: the traditional renderer).
 void check_options(const LoadedScene& scene, const RenderOptions& options);
 
 }  // namespace amalgam

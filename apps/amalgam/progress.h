@@ -1,0 +1,66 @@
+#pragma once
+/// \file What `render` shows on a terminal while it works: the phase it is in (reading,
+/// building and baking) once a phase takes over a second, then a progress bar over the samples.
+/// Nothing is shown when stderr is not a terminal or with --quiet; every line shown is ended
+/// before anything else is printed.
+
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <string>
+#include <thread>
+
+namespace amalgam::cli {
+
+/// Seconds a phase or render runs before it is shown: 1, or the environment's
+/// AMALGAM_PROGRESS_AFTER (a number of seconds; the tests set 0).
+double progress_delay();
+
+/// "reading scene.json: 2.4 s" on stderr, updated four times a second by a thread of its own,
+/// for as long as the phase lasts and once it has lasted progress_delay() seconds.
+class PhaseStatus {
+ public:
+  explicit PhaseStatus(bool enabled);
+  ~PhaseStatus();  ///< stop()
+  PhaseStatus(const PhaseStatus&) = delete;
+  PhaseStatus& operator=(const PhaseStatus&) = delete;
+  /// Starts a new phase (its clock restarts).
+  void phase(const std::string& what);
+  /// Ends the display (and its line, if one was shown); idempotent.
+  void stop();
+
+ private:
+  using clock = std::chrono::steady_clock;
+  void run();
+  bool enabled_;
+  double delay_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::string what_;
+  clock::time_point since_ = clock::now();
+  bool stopping_ = false;
+  bool shown_ = false;
+  std::thread thread_;
+};
+
+/// A one-line progress bar with ETA over the samples per pixel, after progress_delay().
+class Progress {
+ public:
+  Progress(int total, bool enabled);
+  ~Progress() { finish(); }
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+  void update(int done);
+  /// Ends the bar's line if one was shown, so that what follows starts a line of its own.
+  void finish();
+
+ private:
+  using clock = std::chrono::steady_clock;
+  int total_;
+  bool enabled_;
+  double delay_;
+  bool shown_ = false;
+  clock::time_point start_ = clock::now();
+};
+
+}  // namespace amalgam::cli

@@ -1,0 +1,97 @@
+#!/usr/bin/python3
+"""Composes the demo strip (out/demo.png) from the renders scripts/demo.sh makes.
+
+Columns: each scene size rendered traditionally and scale-sensitively. Rows: the image; its exact
+cost (intersection tests per pixel, all rays of the pixel, per sample) on one log scale shared by
+every column, with its colour bar; and, for the scale-sensitive columns, the level of the amalgam
+rendered at each pixel (a traditional renderer never renders one). Under each cost image: the
+mean tests per primary ray (shadow rays included) and the render time, from the stats JSON.
+
+Usage: demo_strip.py DIR OUT.png   (DIR holds NAME.png, NAME-cost.pfm, NAME-level.pfm and
+NAME.json for every NAME listed in DIR/strip.json)
+"""
+
+import json
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.image as mpimg  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.colors import BoundaryNorm, LogNorm  # noqa: E402
+
+
+def read_pfm(path):
+    """A PFM image as a float32 array (rows from the top), one channel if it is grey."""
+    with open(path, "rb") as f:
+        kind = f.readline().strip()
+        width, height = (int(v) for v in f.readline().split())
+        scale = float(f.readline())
+        channels = 3 if kind == b"PF" else 1
+        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
+    img = data.reshape(height, width, channels)[::-1]
+    return img[:, :, 0] if channels == 3 and np.all(img[:, :, 0] == img[:, :, 1]) else img
+
+
+def main():
+    src, out = Path(sys.argv[1]), Path(sys.argv[2])
+    strip = json.loads((src / "strip.json").read_text())
+    columns = strip["columns"]
+    costs = [read_pfm(src / f"{c['name']}-cost.pfm") for c in columns]
+    lo = max(1.0, min(float(c[c > 0].min()) for c in costs))
+    hi = max(float(c.max()) for c in costs)
+    cost_norm = LogNorm(vmin=lo, vmax=hi)
+    has_level = [(src / f"{c['name']}-level.pfm").exists() for c in columns]
+    rows = 3 if any(has_level) else 2
+    fig, axes = plt.subplots(rows, len(columns), figsize=(3.1 * len(columns), 2.55 * rows + 0.9),
+                             squeeze=False, constrained_layout=True)
+    max_level = 0
+    levels = []
+    for c, ok in zip(columns, has_level):
+        lv = read_pfm(src / f"{c['name']}-level.pfm") if ok else None
+        levels.append(lv)
+        if lv is not None and np.any(lv >= 0):
+            max_level = max(max_level, int(np.nanmax(lv)))
+    level_cmap = plt.get_cmap("turbo", max_level + 2)
+    level_norm = BoundaryNorm(np.arange(-1.5, max_level + 1.5), level_cmap.N)
+    cost_im = level_im = None
+    for j, c in enumerate(columns):
+        stats = json.loads((src / f"{c['name']}.json").read_text())
+        per_ray = stats["per_primary_ray"]["mean"]
+        seconds = stats.get("seconds", stats.get("render_seconds"))
+        axes[0][j].imshow(mpimg.imread(src / f"{c['name']}.png"))
+        axes[0][j].set_title(c["title"], fontsize=9)
+        cost_im = axes[1][j].imshow(costs[j], cmap="viridis", norm=cost_norm)
+        label = f"{per_ray:.1f} tests per ray"
+        if isinstance(seconds, (int, float)):
+            label += f", {seconds:.2f} s"
+        axes[1][j].set_xlabel(label, fontsize=9)
+        if rows == 3:
+            if levels[j] is not None and c["renderer"] == "scale-sensitive":
+                lv = np.where(np.isnan(levels[j]), -1, levels[j])
+                level_im = axes[2][j].imshow(np.rint(lv), cmap=level_cmap, norm=level_norm,
+                                             interpolation="nearest")
+                axes[2][j].set_xlabel("level rendered (-1: primitive or sky)", fontsize=8)
+            else:
+                axes[2][j].text(0.5, 0.5, "traditional:\nevery bounding volume\nis traversed,\n"
+                                "never rendered", ha="center", va="center", fontsize=9,
+                                transform=axes[2][j].transAxes)
+        for ax in axes[:, j]:
+            ax.set_xticks([])
+            ax.set_yticks([])
+    fig.colorbar(cost_im, ax=list(axes[1]), shrink=0.9,
+                 label="intersection tests per pixel (log)")
+    if level_im is not None:
+        fig.colorbar(level_im, ax=list(axes[2]), shrink=0.9, label="level",
+                     ticks=range(-1, max_level + 1, max(1, (max_level + 1) // 8)))
+    fig.suptitle(strip["title"], fontsize=11)
+    tmp = out.with_suffix(".tmp.png")
+    fig.savefig(tmp, dpi=110)
+    tmp.replace(out)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,106 @@
+// `--tracer embree` on the command line: what it refuses (exit 2, one line), what it reports.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliResult {
+  int status;
+  std::string out, err;
+};
+
+CliResult run(const std::string& args) {
+  const fs::path err = fs::temp_directory_path() / ("amalgam-embree-" + std::to_string(getpid()));
+  const std::string cmd = std::string(AMALGAM_BINARY) + " " + args + " 2>" + err.string();
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  std::size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int st = pclose(p);
+  std::ifstream in(err);
+  std::string e{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  fs::remove(err);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out, e};
+}
+
+const std::string kOut = (fs::temp_directory_path() / "amalgam-embree-cli.pfm").string();
+const std::string kRender =
+    "render builtin:prisms --set depth=3 --width 16 --height 12 --spp 1 "
+    "--quiet --out " +
+    kOut;
+
+/// One line on stderr naming `word`, exit 2, no image.
+void expect_refused(const std::string& args, const std::string& word) {
+  fs::remove(kOut);
+  const CliResult r = run(args);
+  EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(word), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(kOut)) << args;
+}
+
+TEST(CliEmbree, UnknownTracerIsRefused) {
+  expect_refused(kRender + " --tracer optix", "--tracer");
+}
+
+#if defined(AMALGAM_HAVE_EMBREE)
+TEST(CliEmbree, OptionsThatChooseOrBlendAmalgamsAreRefused) {
+  const std::string e = kRender + " --tracer embree";
+  expect_refused(e + " --renderer scale-sensitive", "--renderer scale-sensitive");
+  expect_refused(e + " --level 1", "--level");
+  expect_refused(e + " --footprint 2", "--footprint");
+  expect_refused(e + " --opacity deterministic", "--opacity deterministic");
+  expect_refused(e + " --order sorted", "--order");
+  expect_refused(e + " --order unsorted", "--order");
+  expect_refused(e + " --cost-image /tmp/amalgam-embree-cost.png", "--cost-image");
+  expect_refused("trace builtin:prisms --tracer embree --footprint 2", "--footprint");
+  // A builtin too large to list for Embree: refused before any rendering.
+  expect_refused("render builtin:line --set depth=30 --tracer embree --quiet --out " + kOut,
+                 "primitives");
+}
+
+TEST(CliEmbree, RendersAndReportsWhatItMeasured) {
+  const CliResult r = run(kRender + " --tracer embree --renderer traditional --stats -");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(kOut));
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["tracer"], "embree");
+  EXPECT_EQ(j["renderer"], "traditional");
+  EXPECT_TRUE(j["tests"].is_null());
+  EXPECT_TRUE(j["per_primary_ray"].is_null());
+  EXPECT_TRUE(j["opacity"].is_null());
+  EXPECT_TRUE(j["order"].is_null());
+  EXPECT_EQ(j["rays"]["primary"], 16 * 12);
+  EXPECT_GE(j["time_s"]["embree_build"].get<double>(), 0.0);
+  EXPECT_GE(j["time_s"]["render"].get<double>(), 0.0);
+  const CliResult t = run("trace builtin:line --tracer embree");
+  ASSERT_EQ(t.status, 0) << t.err;
+  const nlohmann::json h = nlohmann::json::parse(t.out);
+  EXPECT_EQ(h["hit"]["object"]["kind"], "primitive");
+  EXPECT_EQ(h["rays"]["primary"], 1);
+  // amalgam's tracer says so too.
+  const CliResult a = run(kRender + " --stats -");
+  ASSERT_EQ(a.status, 0) << a.err;
+  EXPECT_EQ(nlohmann::json::parse(a.out)["tracer"], "amalgam");
+  fs::remove(kOut);
+}
+#else
+TEST(CliEmbree, ABuildWithoutEmbreeSaysSo) {
+  expect_refused(kRender + " --tracer embree", "built without Embree");
+}
+#endif
+
+}  // namespace

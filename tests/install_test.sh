@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# `cmake --install` gives a usable package: a consumer program configured with only
+# find_package(amalgam) builds against the installed headers and libraries, gets none of our
+# build flags (warnings, -Werror, ISA defines), and renders exactly what the CLI renders.
+# Usage: install_test.sh BUILD_DIR SOURCE_DIR
+set -euo pipefail
+build=$1 src=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cmake --install "$build" --prefix "$tmp/prefix" >/dev/null
+for f in bin/amalgam bin/amalgam-import include/amalgam/render/render.h \
+         include/amalgam/render/render_isa.inl lib/cmake/amalgam/amalgamConfig.cmake; do
+  [ -e "$tmp/prefix/$f" ] || { echo "not installed: $f"; exit 1; }
+done
+unset CXXFLAGS CMAKE_CXX_COMPILER_LAUNCHER
+cmake -S "$src/tests/install/consumer" -B "$tmp/consumer" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_PREFIX_PATH="$tmp/prefix" -DCMAKE_EXPORT_COMPILE_COMMANDS=ON >/dev/null
+cmake --build "$tmp/consumer" >/dev/null
+if grep -E -- '-Werror|-Wpedantic|-mavx|AMALGAM_BUILD_AVX2_COPY|AMALGAM_IMPORT_HELPER' \
+     "$tmp/consumer/compile_commands.json"; then
+  echo "build flags of amalgam leaked into the consumer"; exit 1
+fi
+if grep -q -- "$src/src" "$tmp/consumer/compile_commands.json"; then
+  echo "the consumer includes from the source tree, not the installed headers"; exit 1
+fi
+export AMALGAM_IMPORT_HELPER="$tmp/prefix/bin/amalgam-import"
+for scene in builtin:line /usr/share/assimp/models/PLY/Wuson.ply; do
+  line=$("$tmp/consumer/consumer" "$scene")
+  echo "$line"
+  tests=$(sed -E 's/.* ([0-9]+) tests.*/\1/' <<<"$line")
+  cli=$("$tmp/prefix/bin/amalgam" render "$scene" --width 32 --height 24 --spp 2 --threads 1 \
+          --out "$tmp/cli.pfm" --stats - --quiet |
+        python3 -c 'import json,sys; print(json.load(sys.stdin)["tests"]["total"])')
+  [ "$tests" = "$cli" ] || { echo "$scene: consumer counted $tests tests, the CLI $cli"; exit 1; }
+done
+echo "install ok"
