@@ -224,6 +224,33 @@ TEST(Texture, AMissingTextureIsOneWarningAndTheBaseColour) {
   EXPECT_NE(c.dropped[0].find("corrupt PNG data"), std::string::npos) << c.dropped[0];
 }
 
+TEST(Texture, ObjCorruptJpegAndMissingCoordinatesWarnAndRender) {
+  REQUIRE_MODELS();
+  const fs::path d = scratch_dir() / "obj";
+  fs::create_directories(d);
+  write(d / "m.mtl", "newmtl bad\nKd 0.5 0.25 1\nmap_Kd bad.jpg\nnewmtl good\nmap_Kd good.jpg\n");
+  // A JPEG that fails in its header (libjpeg's error exit, not a crash); real JPEG texels.
+  write(d / "bad.jpg", std::string("\xff\xd8\xff\xe0\x00\x02garbage", 14));
+  fs::copy_file("/usr/share/assimp/models/OBJ/SpiderTex.jpg", d / "good.jpg");
+  write(d / "a.obj",
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+        "usemtl bad\nf 1/1 2/2 3/3\n");
+  const ImportedMesh a = import_mesh((d / "a.obj").string());
+  EXPECT_EQ(a.textures.size(), 1u);  // good.jpg: every material of the library is read
+  EXPECT_EQ(a.materials[a.triangles[0].material].texture, -1);
+  ASSERT_EQ(a.dropped.size(), 1u);
+  EXPECT_NE(a.dropped[0].find("corrupt JPEG data"), std::string::npos) << a.dropped[0];
+  EXPECT_NE(a.dropped[0].find("'bad.jpg'"), std::string::npos) << a.dropped[0];
+  EXPECT_EQ(a.materials[a.triangles[0].material].colour, (Vec3{0.5f, 0.25f, 1.0f}));
+  // A textured material on a mesh without texture coordinates: its colour alone, said once.
+  write(d / "b.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl good\nf 1 2 3\n");
+  const ImportedMesh b = import_mesh((d / "b.obj").string());
+  ASSERT_EQ(b.textures.size(), 1u);
+  EXPECT_EQ(b.materials[b.triangles[0].material].texture, -1);
+  ASSERT_EQ(b.dropped.size(), 2u);  // bad.jpg again, and the coordinates
+  EXPECT_NE(b.dropped[1].find("no texture coordinates"), std::string::npos) << b.dropped[1];
+}
+
 TEST(GltfCamera, TheFirstPerspectiveCameraAsTheFileGivesIt) {
   REQUIRE_MODELS();
   const std::string path = (kGltf / "cameras/Cameras.gltf").string();
