@@ -78,14 +78,15 @@ TEST(Texture, TriangleHitCarriesTheBarycentricsOfItsPoint) {
   EXPECT_NEAR(hit->b2, 0.25f, 1e-6f);  // weight of c: y / 2
 }
 
-/// A unit quad in z = 0 of two triangles whose texture coordinates map it onto [0,1]^2,
-/// material 0 textured with `tex` and colour factor `factor`.
-ExplicitHierarchy textured_quad(const Texture& tex, Vec3 factor, const BuildConfig& cfg = {}) {
+/// A unit quad in z = 0 of two triangles whose texture coordinates map it onto
+/// [u0, u1] x [0, 1], material 0 textured with `tex` and colour factor `factor`.
+ExplicitHierarchy textured_quad(const Texture& tex, Vec3 factor, const BuildConfig& cfg = {},
+                                float u0 = 0.0f, float u1 = 1.0f) {
   std::vector<Primitive> prims = {Primitive::triangle({0, 0, 0}, {1, 0, 0}, {1, 1, 0}),
                                   Primitive::triangle({0, 0, 0}, {1, 1, 0}, {0, 1, 0})};
   TexCoords t0, t1;
-  t0.u[0] = 0, t0.v[0] = 0, t0.u[1] = 1, t0.v[1] = 0, t0.u[2] = 1, t0.v[2] = 1;
-  t1.u[0] = 0, t1.v[0] = 0, t1.u[1] = 1, t1.v[1] = 1, t1.u[2] = 0, t1.v[2] = 1;
+  t0.u[0] = u0, t0.v[0] = 0, t0.u[1] = u1, t0.v[1] = 0, t0.u[2] = u1, t0.v[2] = 1;
+  t1.u[0] = u0, t1.v[0] = 0, t1.u[1] = u1, t1.v[1] = 1, t1.u[2] = u0, t1.v[2] = 1;
   Surface s;
   s.colour = factor;
   s.texture = 0;
@@ -110,19 +111,64 @@ TEST(Texture, SurfaceAtTheHitIsTheTextureTimesTheFactor) {
   }
 }
 
-TEST(Texture, AmalgamsBakeTheMeanTexelColourTimesTheFactor) {
-  // Mean over the texels (not over the area the triangles cover): here the same thing.
-  const Texture tex = two_texels(30, 220);
-  const Vec3 factor{0.5f, 1.0f, 0.25f};
+TEST(Texture, MeanOverATriangleMatchesDenseSampling) {
+  Texture t;
+  t.width = 3, t.height = 2;
+  t.texels = {10, 200, 30, 250, 0, 90, 60, 60, 60, 255, 255, 255, 0, 0, 0, 128, 20, 200};
+  finish_texture(t);
+  TexCoords c;
+  c.u[0] = -0.3f, c.v[0] = 0.1f, c.u[1] = 1.7f, c.v[1] = 0.4f, c.u[2] = 0.5f, c.v[2] = 2.2f;
+  // Reference: 800 x 800 grid of barycentric points, inside the triangle.
+  Vec3 ref{};
+  int n = 0;
+  for (int i = 0; i < 800; ++i)
+    for (int j = 0; i + j < 800; ++j) {
+      float u, v;
+      interpolate(c, (static_cast<float>(i) + 0.3f) / 800.0f,
+                  (static_cast<float>(j) + 0.3f) / 800.0f, u, v);
+      ref += sample(t, u, v);
+      ++n;
+    }
+  ref = ref / static_cast<float>(n);
+  const Vec3 got = mean_over_triangle(t, c);
+  EXPECT_NEAR(got.x, ref.x, 0.01f);
+  EXPECT_NEAR(got.y, ref.y, 0.01f);
+  EXPECT_NEAR(got.z, ref.z, 0.01f);
+}
+
+BuildConfig bake_rays(int rays) {
   BuildConfig cfg;
-  cfg.bake.rays = 64;
-  const ExplicitHierarchy h = textured_quad(tex, factor, cfg);
-  const Vec3 want = tex.mean * factor;
+  cfg.bake.rays = rays;
+  return cfg;
+}
+
+TEST(Texture, AmalgamsBakeTheMeanTextureColourTimesTheFactor) {
+  const Vec3 factor{0.5f, 1.0f, 0.25f};
+  // A texture mapped once onto its geometry: the mean over the texels. (A 2 x 2 checker, the
+  // same on both sides of the quad's diagonal, so that both triangles have that mean.)
+  Texture checker;
+  checker.width = 2, checker.height = 2;
+  checker.texels = {40, 40, 40, 230, 230, 230, 230, 230, 230, 40, 40, 40};
+  finish_texture(checker);
+  const ExplicitHierarchy h = textured_quad(checker, factor, bake_rays(64));
+  const Vec3 want = checker.mean * factor;
   const Vec3 got = h.appearances[0].surface.colour;
-  EXPECT_NEAR(got.x, want.x, 1e-6f);
-  EXPECT_NEAR(got.y, want.y, 1e-6f);
-  EXPECT_NEAR(got.z, want.z, 1e-6f);
+  EXPECT_NEAR(got.x, want.x, 0.01f * want.x);
+  EXPECT_NEAR(got.y, want.y, 0.01f * want.y);
+  EXPECT_NEAR(got.z, want.z, 0.01f * want.z);
   EXPECT_EQ(h.appearances[0].surface.texture, -1);
+  // Part of an atlas: the mean over the area the coordinates cover, not over all texels. Texels
+  // dark, dark, bright, bright, clamped; the quad shows u in [0.125, 0.375]: dark only.
+  Texture atlas;
+  atlas.width = 4, atlas.height = 1;
+  atlas.texels = {20, 20, 20, 20, 20, 20, 240, 240, 240, 240, 240, 240};
+  atlas.wrap_u = atlas.wrap_v = Wrap::kClamp;
+  finish_texture(atlas);
+  const ExplicitHierarchy part = textured_quad(atlas, factor, bake_rays(64), 0.125f, 0.375f);
+  const Vec3 dark = Vec3{1, 1, 1} * srgb_to_linear(20) * factor;
+  EXPECT_NEAR(part.appearances[0].surface.colour.x, dark.x, 1e-6f);
+  EXPECT_NEAR(part.appearances[0].surface.colour.z, dark.z, 1e-6f);
+  EXPECT_GT(atlas.mean.x * factor.x, 10.0f * dark.x);  // what the texels' mean would give
 }
 
 TEST(Texture, BoxTexturedImportsItsTextureAndEveryVariantTheSameImage) {

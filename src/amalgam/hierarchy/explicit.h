@@ -67,11 +67,15 @@ class ExplicitHierarchy {
     }
     return m;
   }
-  /// The colour an amalgam bakes for material `m`: its colour times its texture's mean.
-  Vec3 mean_colour(const Surface& m) const {
+  /// The colour an amalgam bakes for primitive `id`: its material's colour, times, when
+  /// textured, the texture's mean over the triangle's texture coordinates (or over all its
+  /// texels when the primitive has no coordinates).
+  Vec3 bake_colour(PrimId id) const {
+    const Surface& m = materials[prims[id].material];
     if (m.texture < 0 || !textures || static_cast<std::size_t>(m.texture) >= textures->size())
       return m.colour;
-    return m.colour * (*textures)[static_cast<std::size_t>(m.texture)].mean;
+    const Texture& t = (*textures)[static_cast<std::size_t>(m.texture)];
+    return m.colour * (uvs.empty() ? t.mean : mean_over_triangle(t, uvs[id]));
   }
   /// The SoA child boxes when they match `nodes` (else null: the traversal's generic path).
   const WideNodes* wide_nodes() const {

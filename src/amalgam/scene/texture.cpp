@@ -88,4 +88,29 @@ Vec3 sample(const Texture& t, float u, float v) {
   return top * (1.0f - fy) + bottom * fy;
 }
 
+Vec3 mean_over_triangle(const Texture& t, const TexCoords& c) {
+  // Area in texels (finite coordinates only: `sample` maps the others to 0).
+  const double du1 = double(c.u[1]) - c.u[0], dv1 = double(c.v[1]) - c.v[0];
+  const double du2 = double(c.u[2]) - c.u[0], dv2 = double(c.v[2]) - c.v[0];
+  double texels = 0.5 * std::fabs(du1 * dv2 - du2 * dv1) * t.width * t.height;
+  if (!std::isfinite(texels)) texels = 0.0;
+  const int n = static_cast<int>(std::clamp(std::ceil(std::sqrt(texels)), 4.0, 64.0));
+  Vec3 sum{};
+  const float inv = 1.0f / static_cast<float>(n);
+  // Sub-triangle centroids in barycentric (b1, b2): n (n + 1) / 2 upright, n (n - 1) / 2
+  // inverted, all of area 1 / n^2 of the triangle.
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; i + j < n; ++j) {
+      for (int up = 0; up < 2; ++up) {
+        if (up == 1 && i + j > n - 2) continue;
+        const float off = up ? 2.0f / 3.0f : 1.0f / 3.0f;
+        float u, v;
+        interpolate(c, (static_cast<float>(i) + off) * inv, (static_cast<float>(j) + off) * inv, u,
+                    v);
+        sum += sample(t, u, v);
+      }
+    }
+  return sum / static_cast<float>(n * n);
+}
+
 }  // namespace amalgam

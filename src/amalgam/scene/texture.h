@@ -39,6 +39,12 @@ void finish_texture(Texture& t);
 /// texels (> 0).
 Vec3 sample(const Texture& t, float u, float v);
 
+/// The mean linear colour of `t` over the triangle `c` covers in texture space (what an amalgam
+/// bakes for a textured triangle): the midpoint rule over the n^2 equal sub-triangles of the
+/// triangle cut n ways along each edge, n from 4 up to 64 as the triangle covers more texels
+/// (about one sample per texel), each sample bilinear as `sample`.
+Vec3 mean_over_triangle(const Texture& t, const TexCoords& c);
+
 /// The coordinates of the point with barycentric weights (1 - b1 - b2, b1, b2).
 inline void interpolate(const TexCoords& c, float b1, float b2, float& u, float& v) {
   const float b0 = 1.0f - b1 - b2;
