@@ -4,7 +4,7 @@
 set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
-  libtbb-dev libpng-dev libopenexr-dev nlohmann-json3-dev libcli11-dev
+  libtbb-dev libpng-dev libjpeg62-turbo-dev libopenexr-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libbenchmark-dev
   libassimp-dev assimp-testmodels
   libembree-dev

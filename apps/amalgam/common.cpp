@@ -2,6 +2,8 @@
 
 #include <cctype>
 #include <charconv>
+#include <cmath>
+#include <iostream>
 #include <sstream>
 #include <system_error>
 
@@ -43,6 +45,20 @@ void CommonOptions::add_to(CLI::App& app) {
   app.add_option("--seed", seed, "seed of all randomness, 0 .. 2^64-1 (default 0)");
   app.add_option("--threads", threads, "worker threads (default: all cores)")
       ->check(non_negative_int());
+  app.add_option("--camera", camera,
+                 "view from the scene file's camera NAME or INDEX (glTF; default: the first)");
+  app.add_option("--eye", eye, "camera position x,y,z (replaces the scene's)");
+  app.add_option("--look-at", look_at, "point the camera looks at, x,y,z");
+  app.add_option("--up", up, "camera up direction x,y,z");
+  app.add_option("--fov", fov, "vertical field of view in degrees (0 < DEG < 180)");
+}
+
+void CommonOptions::prepare(LoadedScene& scene) const {
+  choose_camera(scene, view);
+}
+
+void print_warnings(const LoadedScene& scene) {
+  for (const std::string& w : scene.warnings) std::cerr << "amalgam: warning: " << w << "\n";
 }
 
 void CommonOptions::finish() {
@@ -83,6 +99,23 @@ void CommonOptions::finish() {
   options.footprint = footprint;
   options.seed = parse_seed(seed);
   options.threads = threads;
+  view = CameraChoice{};
+  view.camera = camera;
+  if (!eye.empty()) view.eye = parse_vec3(eye, "--eye");
+  if (!look_at.empty()) view.look_at = parse_vec3(look_at, "--look-at");
+  if (!up.empty()) view.up = parse_vec3(up, "--up");
+  if (!fov.empty()) {
+    std::size_t end = 0;
+    double x = NAN;
+    try {
+      x = std::stod(fov, &end);
+    } catch (const std::exception&) {
+    }
+    if (end != fov.size() || !(x > 0.0 && x < 180.0))
+      throw InputError("--fov " + one_line(fov, 40) +
+                       ": expected a vertical field of view in degrees, > 0 and < 180");
+    view.fov_deg = static_cast<float>(x);
+  }
 }
 
 Params CommonOptions::params() const {

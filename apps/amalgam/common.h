@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "amalgam/builtin/params.h"
+#include "amalgam/load/load_scene.h"
 #include "amalgam/math/vec.h"
 #include "amalgam/render/options.h"
 
@@ -29,6 +30,8 @@ struct CommonOptions {
   CLI::Option* renderer_option = nullptr;
   CLI::Option* opacity_option = nullptr;
   CLI::Option* order_option = nullptr;
+  std::string camera, eye, look_at, up, fov;  ///< the view options, as given
+  CameraChoice view;                          ///< set by finish()
 
   /// Registers SCENE, --set and the renderer options of CONTRACT.md on `app`.
   void add_to(CLI::App& app);
@@ -36,6 +39,8 @@ struct CommonOptions {
   /// --tracer embree cannot honour (it renders at full detail) or a build without Embree.
   void finish();
   Params params() const;
+  /// Applies the view options to a loaded scene (choose_camera).
+  void prepare(LoadedScene& scene) const;
 };
 
 /// CLI11 validators with short messages of our own (CLI11's range messages print both bounds
@@ -55,6 +60,10 @@ std::uint64_t parse_bytes(const std::string& text, const std::string& option);
 /// scene.json", "rendering", ...). Set by the subcommands as they go.
 void set_activity(std::string what);
 const std::string& activity();
+
+/// Prints what a loaded scene holds that is not rendered, one line each on stderr
+/// ("amalgam: warning: ...").
+void print_warnings(const LoadedScene& scene);
 
 /// Parses "x,y,z" into three floats; throws InputError naming the option.
 Vec3 parse_vec3(const std::string& text, const std::string& option);

@@ -219,7 +219,8 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
     set_activity(what);
     status.phase(what);
   };
-  const LoadedScene scene = load_scene(common.scene, common.params(), budget);
+  LoadedScene scene = load_scene(common.scene, common.params(), budget);
+  common.prepare(scene);  // the view options, before the fingerprint takes the camera
   check_options(scene, o);
   const bool embree = o.tracer == TracerKind::kEmbree;
 #if defined(AMALGAM_HAVE_EMBREE)
@@ -231,6 +232,7 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   }
 #endif
   status.stop();
+  print_warnings(scene);  // after the load phases' status line
 
   const std::string fp = fingerprint(common, scene);
   FilmState state;
@@ -366,7 +368,9 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
 int run_trace(CommonOptions& common, const std::string& origin, const std::string& direction) {
   common.finish();
   set_activity("loading and building " + common.scene);
-  const LoadedScene scene = load_scene(common.scene, common.params());
+  LoadedScene scene = load_scene(common.scene, common.params());
+  common.prepare(scene);
+  print_warnings(scene);
   check_options(scene, common.options);
   Ray ray = scene.env.camera.centre_ray(common.options.width, common.options.height);
   if (!origin.empty() || !direction.empty()) {

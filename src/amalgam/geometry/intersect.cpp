@@ -102,7 +102,7 @@ SurfaceHit triangle_finish(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, const Triangl
   const float u = h.u, v = h.v, w = h.w;
   const Vec3 p = a * (u * inv) + b * (v * inv) + c * (w * inv);
   const Vec3 err = (abs(a * (u * inv)) + abs(b * (v * inv)) + abs(c * (w * inv))) * gamma(7);
-  return SurfaceHit{h.t, n, p, err};
+  return SurfaceHit{h.t, n, p, err, v * inv, w * inv};
 }
 
 std::optional<SurfaceHit> intersect_sphere(const Ray& ray, Vec3 center, float radius) {

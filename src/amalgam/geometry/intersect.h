@@ -30,12 +30,15 @@ inline std::optional<Span> intersect_box(const Ray& ray, const Bbox& box);
 
 /// A surface hit: parameter, geometric normal (unit length, facing against the ray), the
 /// hit point and a per-component bound on its absolute rounding error (for offsetting
-/// secondary-ray origins without a fixed epsilon).
+/// secondary-ray origins without a fixed epsilon). On a triangle (a, b, c), `b1` and `b2` are
+/// the barycentric weights of b and c from the counted test (texture coordinates are
+/// interpolated with them); 0 on other primitives.
 struct SurfaceHit {
   float t;
   Vec3 normal;
   Vec3 p;
   Vec3 p_error;
+  float b1 = 0.0f, b2 = 0.0f;
 };
 
 /// gamma(n) of Pharr, Jakob, Humphreys (pbrt 3, section 3.9.1): bounds n rounding errors.

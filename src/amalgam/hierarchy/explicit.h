@@ -4,11 +4,13 @@
 /// contiguous range of primitives.
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "amalgam/hierarchy/bake/normals.h"
 #include "amalgam/hierarchy/hierarchy.h"
 #include "amalgam/hierarchy/wide.h"
+#include "amalgam/scene/texture.h"
 
 namespace amalgam {
 
@@ -25,6 +27,11 @@ class ExplicitHierarchy {
   std::vector<Appearance> appearances;  ///< one per node
   std::vector<Primitive> prims;
   std::vector<Surface> materials;  ///< indexed by Primitive::material
+  /// Texture coordinates per primitive (same order as `prims`) when a material is textured,
+  /// else empty: a side table, so untextured scenes pay nothing.
+  std::vector<TexCoords> uvs;
+  /// The textures `Surface::texture` indexes (shared by the meshes of an instanced scene).
+  std::shared_ptr<const std::vector<Texture>> textures;
   int levels = 0;
   /// The normal tensor (trace 1) of the root's contents, from the bake: lets an instance
   /// level above compose normals across the instance boundary.
@@ -46,6 +53,30 @@ class ExplicitHierarchy {
     return amalgam::intersect(prims[id], ray);
   }
   Surface surface(PrimId id) const { return materials[prims[id].material]; }
+  /// The surface at hit `s` on primitive `id`: its texture, if any, sampled at the
+  /// coordinates interpolated with the hit's barycentrics, times the material's colour.
+  Surface surface_at(PrimId id, const SurfaceHit& s) const {
+    Surface m = materials[prims[id].material];
+    if (m.texture >= 0) {
+      if (!uvs.empty() && textures && static_cast<std::size_t>(m.texture) < textures->size()) {
+        float u, v;
+        interpolate(uvs[id], s.b1, s.b2, u, v);
+        m.colour = m.colour * sample((*textures)[static_cast<std::size_t>(m.texture)], u, v);
+      }
+      m.texture = -1;
+    }
+    return m;
+  }
+  /// The colour an amalgam bakes for primitive `id`: its material's colour, times, when
+  /// textured, the texture's mean over the triangle's texture coordinates (or over all its
+  /// texels when the primitive has no coordinates).
+  Vec3 bake_colour(PrimId id) const {
+    const Surface& m = materials[prims[id].material];
+    if (m.texture < 0 || !textures || static_cast<std::size_t>(m.texture) >= textures->size())
+      return m.colour;
+    const Texture& t = (*textures)[static_cast<std::size_t>(m.texture)];
+    return m.colour * (uvs.empty() ? t.mean : mean_over_triangle(t, uvs[id]));
+  }
   /// The SoA child boxes when they match `nodes` (else null: the traversal's generic path).
   const WideNodes* wide_nodes() const {
     return !nodes.empty() && wide.headers.size() == nodes.size() ? &wide : nullptr;

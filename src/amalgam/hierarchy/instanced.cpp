@@ -94,6 +94,7 @@ std::optional<SurfaceHit> InstancedHierarchy::intersect(PrimId p, const Ray& ray
              gamma(3) * (dot(in.abs_rows[i], ap) + std::fabs(in.to_world.m[i][3]));
   }
   w.p_error = err;
+  w.b1 = hit->b1, w.b2 = hit->b2;  // an affine map keeps barycentrics
   return w;
 }
 

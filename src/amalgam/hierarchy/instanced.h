@@ -80,6 +80,9 @@ class InstancedHierarchy {
     const InstanceData& in = instances[slot(p) - 1];
     return meshes[in.mesh].surface(local(p));
   }
+  Surface surface_at(PrimId p, const SurfaceHit& s) const {
+    return meshes[instances[slot(p) - 1].mesh].surface_at(local(p), s);
+  }
   HierarchyInfo info() const;
   /// The primitive in world space (for flatten() and tests).
   Primitive primitive(PrimId p) const;

@@ -6,11 +6,14 @@
 #include <algorithm>
 #include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <new>
 #include <string>
 #include <vector>
 
+#include "amalgam/io/assimp_scene.h"
 #include "amalgam/util/error.h"
 
 namespace amalgam {
@@ -48,17 +51,10 @@ constexpr const char* kCorruptionMessages[] = {
     "fails on mesh positions",      // FindInvalidData: NaN or infinite vertex positions
 };
 
-float clamp01(float v) {
-  return std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.8f;
-}
-
-Surface read_material(const aiMaterial& m) {
-  Surface s;
-  aiColor4D c;
-  if (m.Get(AI_MATKEY_BASE_COLOR, c) == aiReturn_SUCCESS ||
-      m.Get(AI_MATKEY_COLOR_DIFFUSE, c) == aiReturn_SUCCESS)
-    s.colour = {clamp01(c.r), clamp01(c.g), clamp01(c.b)};
-  return s;
+bool is_gltf(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".gltf" || ext == ".glb";
 }
 
 }  // namespace
@@ -77,8 +73,17 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
                               aiProcess_PreTransformVertices | aiProcess_SortByPType |
                               aiProcess_FindInvalidData | aiProcess_ValidateDataStructure;
   const aiScene* scene = nullptr;
+  ImportedMesh out;
   try {
-    scene = importer.ReadFile(path, kFlags);
+    // Read, then bake the node transforms: cameras and lights are placed by nodes, which
+    // aiProcess_PreTransformVertices removes. (ReadFile runs the validation, then the other
+    // steps in Assimp's fixed order: the same as one ReadFile with all the flags.)
+    scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
+    if (scene != nullptr && !(scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
+      assimp_scene::read_cameras_lights(*scene, path, is_gltf(path), out);
+      assimp_scene::note_unrendered(*scene, path, out);
+      scene = importer.ApplyPostProcessing(kFlags & ~aiProcess_ValidateDataStructure);
+    }
   } catch (const std::bad_alloc&) {
     fail(path, "the importer ran out of memory (is the file corrupt?)");
   } catch (const std::exception& e) {
@@ -98,12 +103,9 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
   if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
     fail(path, "cannot import: the file holds no complete scene");
 
-  ImportedMesh out;
   out.warnings = std::move(logger->warnings);
-  for (unsigned i = 0; i < scene->mNumMaterials; ++i)
-    out.materials.push_back(scene->mMaterials[i] ? read_material(*scene->mMaterials[i])
-                                                 : Surface{});
-  if (out.materials.empty()) out.materials.push_back(Surface{});
+  const std::vector<unsigned> channel = assimp_scene::read_materials(*scene, path, out);
+  std::vector<std::uint32_t> untextured(out.materials.size(), ~0u);  // copies without texture
 
   std::uint64_t faces = 0;
   for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
@@ -114,6 +116,9 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
     fail(path, std::to_string(faces) + " triangles, more than the limit of " +
                    std::to_string(config.max_triangles));
   out.triangles.reserve(faces);
+  const bool textured = std::any_of(out.materials.begin(), out.materials.end(),
+                                    [](const Surface& s) { return s.texture >= 0; });
+  if (textured) out.uvs.reserve(faces);
 
   for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
     const aiMesh* m = scene->mMeshes[mi];
@@ -127,7 +132,24 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
         fail(path, where + ": vertex " + std::to_string(v) + " is not finite (NaN or infinite)");
     }
-    const std::uint32_t material = m->mMaterialIndex < out.materials.size() ? m->mMaterialIndex : 0;
+    std::uint32_t material = m->mMaterialIndex < out.materials.size() ? m->mMaterialIndex : 0;
+    const aiVector3D* uv = nullptr;
+    if (out.materials[material].texture >= 0) {
+      const unsigned ch = channel[material];
+      if (ch < AI_MAX_NUMBER_OF_TEXTURECOORDS && m->HasTextureCoords(ch)) {
+        uv = m->mTextureCoords[ch];
+      } else {  // nothing to sample the texture with: the material's colour alone
+        if (untextured[material] == ~0u) {
+          untextured[material] = static_cast<std::uint32_t>(out.materials.size());
+          out.materials.push_back(out.materials[material]);
+          out.materials.back().texture = -1;
+        }
+        out.dropped.push_back(path + ": " + where +
+                              " has no texture coordinates for its material's texture: rendered "
+                              "with the material's colour");
+        material = untextured[material];
+      }
+    }
     for (unsigned f = 0; f < m->mNumFaces; ++f) {
       const aiFace& face = m->mFaces[f];
       if (face.mNumIndices != 3) continue;  // points and lines
@@ -151,6 +173,15 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
         continue;
       }
       out.triangles.push_back(Primitive::triangle(p[0], p[1], p[2], material));
+      if (textured) {
+        TexCoords tc;
+        for (int k = 0; uv != nullptr && k < 3; ++k) {
+          const aiVector3D& t = uv[face.mIndices[k]];
+          tc.u[k] = std::isfinite(t.x) ? t.x : 0.0f;
+          tc.v[k] = std::isfinite(t.y) ? t.y : 0.0f;
+        }
+        out.uvs.push_back(tc);
+      }
       out.bounds.extend(p[0]);
       out.bounds.extend(p[1]);
       out.bounds.extend(p[2]);

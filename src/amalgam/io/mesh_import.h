@@ -11,18 +11,26 @@
 #include <string>
 #include <vector>
 
-#include "amalgam/scene/scene.h"
+#include "amalgam/scene/description.h"
 
 namespace amalgam {
 
 /// A mesh as imported: triangles (node transforms already applied) and one surface per
-/// material of the file, in the file's coordinates.
+/// material of the file, in the file's coordinates, with the file's base-colour textures,
+/// cameras and lights.
 struct ImportedMesh {
   std::vector<Primitive> triangles;      ///< all kTriangle; `material` indexes `materials`
-  std::vector<Surface> materials;        ///< never empty
+  std::vector<Surface> materials;        ///< never empty; `texture` indexes `textures`
+  std::vector<TexCoords> uvs;            ///< per triangle when a material is textured, or empty
+  std::vector<Texture> textures;         ///< decoded base-colour images (`mean` set)
+  std::vector<NamedCamera> cameras;      ///< glTF perspective cameras, in file order
+  std::vector<Light> lights;             ///< point and directional lights
   Bbox bounds;                           ///< of `triangles`; never empty
   std::uint64_t dropped_degenerate = 0;  ///< zero-area triangles left out
   std::vector<std::string> warnings;     ///< what Assimp repaired or ignored, one line each
+  /// What the file holds that is not rendered (a spot light, emission, a texture that cannot
+  /// be read, ...), one line each, naming it: for the user (the CLI prints them).
+  std::vector<std::string> dropped;
 };
 
 /// Settings for `import_mesh`.
@@ -38,8 +46,11 @@ struct ImportConfig {
 
 /// Imports the triangles of `path` with Assimp: faces triangulated, node transforms baked
 /// in, points and lines dropped, zero-area triangles dropped. Each material's colour is its
-/// base colour factor (glTF 2 `baseColorFactor`) if present, else its diffuse colour; textures
-/// are ignored. Throws InputError, one line "<path>: <problem>", when Assimp cannot read the
+/// base colour factor (glTF 2 `baseColorFactor`) if present, else its diffuse colour; its
+/// base-colour (or diffuse) texture, from a file beside the mesh or embedded, is decoded in
+/// the helper (PNG or JPEG; one that cannot be read is a line of `dropped`, and the material
+/// keeps its colour). glTF cameras and Assimp's point and directional lights are returned
+/// (docs/import.md). Throws InputError, one line "<path>: <problem>", when Assimp cannot read the
 /// file, when it reports corrupt data it repaired (faces with out-of-range or missing indices,
 /// vertex counts that do not fit the primitive mode), when a vertex is NaN or infinite, when
 /// no triangle with non-zero area is left, or when the importer crashes on it ("the importer

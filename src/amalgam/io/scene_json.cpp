@@ -97,7 +97,11 @@ class SceneParser {
       std::set<const MeshEntry*> seen;
       for (const Placement& p : placements)
         if (!p.expand && seen.insert(p.mesh).second) instanced += p.mesh->mesh->triangles.size();
-      check_memory(r_.file(), MemoryModel::scene(total, instanced, kept), config_);
+      std::uint64_t textures = 0;  // texels once per file; coordinates as read and as built
+      for (const auto& [file, mesh] : imported_)
+        for (const Texture& t : mesh->textures) textures += t.texels.size();
+      if (textures) textures += 2 * sizeof(TexCoords) * (total + instanced);
+      check_memory(r_.file(), MemoryModel::scene(total, instanced, kept) + textures, config_);
     }
     out_.prims.reserve(total);
     out_.instances.reserve(kept);
@@ -145,7 +149,7 @@ class SceneParser {
     if (auto l = r_.find(root, "lights"))
       read_lights(*l);
     else
-      out_.env.lights = default_lights(bounds, out_.env.camera);
+      out_.env.lights = default_lights(bounds, out_.env.camera), out_.default_lights = true;
     return std::move(out_);
   }
 
@@ -169,6 +173,13 @@ class SceneParser {
     std::vector<Primitive> tris(out_.prims.begin() + static_cast<std::ptrdiff_t>(before),
                                 out_.prims.end());
     out_.prims.resize(before);
+    std::vector<TexCoords> uvs;
+    if (out_.uvs.size() > before) {
+      if (!material && !m.mesh->uvs.empty())
+        uvs.assign(out_.uvs.begin() + static_cast<std::ptrdiff_t>(before), out_.uvs.end());
+      out_.uvs.resize(before);
+    }
+    out_.mesh_uvs.push_back(std::move(uvs));
     Bbox b;
     for (const Primitive& t : tris) b.extend(amalgam::bounds(t));
     object_bounds_.push_back(b);
@@ -277,6 +288,12 @@ class SceneParser {
         }
       }
       e.mesh = cached->second;
+      if (warned_.insert(full.string()).second) {
+        out_.warnings.insert(out_.warnings.end(), e.mesh->dropped.begin(), e.mesh->dropped.end());
+        if (!e.mesh->cameras.empty() || !e.mesh->lights.empty())
+          out_.warnings.push_back(full.string() +
+                                  ": its cameras and lights are not used (a scene file's are)");
+      }
       if (auto sub = r_.find(m, "subdivide")) {
         const auto levels = static_cast<int>(r_.integer(*sub, 0, 8));
         const double tris = static_cast<double>(e.mesh->triangles.size()) * std::pow(4.0, levels);
@@ -288,6 +305,7 @@ class SceneParser {
         if (levels > 0) {
           ImportedMesh fine = *e.mesh;
           fine.triangles = subdivide(e.mesh->triangles, levels);
+          fine.uvs = subdivide(e.mesh->uvs, levels);
           e.mesh = std::make_shared<const ImportedMesh>(std::move(fine));
         }
       }
@@ -396,25 +414,14 @@ class SceneParser {
   }
 
   void place(const MeshEntry& m, const Affine& where, std::optional<std::uint32_t> material) {
-    const Affine a = where * m.model;
-    const auto base = static_cast<std::uint32_t>(out_.materials.size());
-    const bool own = !material.has_value();
-    if (own) {
-      // The mesh's own materials, appended once per mesh entry.
+    std::uint32_t base = 0;
+    if (!material) {  // the mesh's own materials (and textures), appended once per mesh entry
       auto it = material_base_.find(&m);
-      if (it == material_base_.end()) {
-        out_.materials.insert(out_.materials.end(), m.mesh->materials.begin(),
-                              m.mesh->materials.end());
-        it = material_base_.emplace(&m, base).first;
-      }
-      for (const Primitive& t : m.mesh->triangles)
-        out_.prims.push_back(
-            Primitive::triangle(a.point(t.a), a.point(t.b), a.point(t.c), it->second + t.material));
-    } else {
-      for (const Primitive& t : m.mesh->triangles)
-        out_.prims.push_back(
-            Primitive::triangle(a.point(t.a), a.point(t.b), a.point(t.c), *material));
+      if (it == material_base_.end())
+        it = material_base_.emplace(&m, scene_json::append_materials(out_, *m.mesh)).first;
+      base = it->second;
     }
+    scene_json::append_mesh(out_, *m.mesh, where * m.model, material, base);
   }
 
   JsonReader r_;
@@ -427,6 +434,7 @@ class SceneParser {
   std::set<std::string> placed_;
   std::map<std::string, const MeshEntry*> by_name_;
   std::map<const MeshEntry*, std::uint32_t> material_base_;
+  std::set<std::string> warned_;  ///< mesh files whose warnings are passed on
   std::map<std::pair<const MeshEntry*, std::int64_t>, std::uint32_t> instanced_;
   std::vector<Bbox> object_bounds_;  ///< per instanced mesh
 };

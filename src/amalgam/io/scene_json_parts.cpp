@@ -131,4 +131,28 @@ AffineD read_matrix(const JsonReader& r, const JsonValue& v) {
   return a;
 }
 
+void append_mesh(SceneDescription& out, const ImportedMesh& mesh, const AffineD& a,
+                 std::optional<std::uint32_t> material, std::uint32_t base) {
+  const bool textured = !material && !mesh.uvs.empty();
+  if (textured || !out.uvs.empty()) out.uvs.resize(out.prims.size());
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const Primitive& t = mesh.triangles[i];
+    out.prims.push_back(Primitive::triangle(a.point(t.a), a.point(t.b), a.point(t.c),
+                                            material ? *material : base + t.material));
+    if (textured) out.uvs.push_back(mesh.uvs[i]);
+  }
+  if (!out.uvs.empty()) out.uvs.resize(out.prims.size());
+}
+
+std::uint32_t append_materials(SceneDescription& out, const ImportedMesh& mesh) {
+  const auto base = static_cast<std::uint32_t>(out.materials.size());
+  const auto shift = static_cast<std::int32_t>(out.textures.size());
+  for (Surface s : mesh.materials) {
+    if (s.texture >= 0) s.texture += shift;
+    out.materials.push_back(s);
+  }
+  out.textures.insert(out.textures.end(), mesh.textures.begin(), mesh.textures.end());
+  return base;
+}
+
 }  // namespace amalgam::scene_json

@@ -3,9 +3,12 @@
 /// material, the camera, a light, a sphere, box or triangle, a transform. Each checks its
 /// value and throws InputError naming the JSON pointer of what is wrong (JsonReader).
 
+#include <optional>
+
 #include "amalgam/io/json_reader.h"
+#include "amalgam/io/mesh_import.h"
 #include "amalgam/math/transform.h"
-#include "amalgam/scene/scene.h"
+#include "amalgam/scene/description.h"
 
 namespace amalgam::scene_json {
 
@@ -33,5 +36,16 @@ AffineD read_transform(const JsonReader& r, const JsonValue& v);
 /// A non-singular affine 4x4 matrix: 4 rows of 4 numbers or 16 numbers, row-major, last row
 /// 0 0 0 1.
 AffineD read_matrix(const JsonReader& r, const JsonValue& v);
+
+/// Appends the triangles of `mesh`, mapped by `a`, to `out.prims`: with `material` for all,
+/// or (none) with the mesh's own materials, which start at `out.materials[base]`. Keeps
+/// `out.uvs` parallel to `out.prims` once any textured material is placed (zeros for
+/// primitives without texture).
+void append_mesh(SceneDescription& out, const ImportedMesh& mesh, const AffineD& a,
+                 std::optional<std::uint32_t> material, std::uint32_t base);
+
+/// Appends the materials of `mesh` to `out.materials`, and its textures to `out.textures`
+/// (the materials' texture indices shifted to match). Returns the index of the first.
+std::uint32_t append_materials(SceneDescription& out, const ImportedMesh& mesh);
 
 }  // namespace amalgam::scene_json

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <filesystem>
 
+#include "amalgam/io/json_reader.h"
 #include "amalgam/io/mesh_import.h"
 #include "amalgam/scene/coordinate_limit.h"
 #include "amalgam/scene/framing.h"
@@ -12,16 +13,23 @@
 namespace amalgam {
 
 AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config) {
+  std::shared_ptr<const std::vector<Texture>> textures;
+  if (!d.textures.empty())
+    textures = std::make_shared<const std::vector<Texture>>(std::move(d.textures));
   if (d.instances.empty())
-    return build_explicit(std::move(d.prims), std::move(d.materials), config);
+    return build_explicit(std::move(d.prims), std::move(d.materials), config, std::move(d.uvs),
+                          std::move(textures));
   std::vector<ExplicitHierarchy> meshes;
   meshes.reserve(d.meshes.size() + 1);
-  for (std::vector<Primitive>& m : d.meshes)
-    meshes.push_back(build_explicit(std::move(m), d.materials, config));
+  for (std::size_t i = 0; i < d.meshes.size(); ++i)
+    meshes.push_back(build_explicit(
+        std::move(d.meshes[i]), d.materials, config,
+        i < d.mesh_uvs.size() ? std::move(d.mesh_uvs[i]) : std::vector<TexCoords>{}, textures));
   if (!d.prims.empty()) {
     Instance loose;  // identity: traced bit-exactly as in an explicit hierarchy
     loose.mesh = static_cast<std::uint32_t>(meshes.size());
-    meshes.push_back(build_explicit(std::move(d.prims), d.materials, config));
+    meshes.push_back(
+        build_explicit(std::move(d.prims), d.materials, config, std::move(d.uvs), textures));
     d.instances.push_back(loose);
   }
   return build_instanced(std::move(meshes), std::move(d.instances), config);
@@ -32,12 +40,19 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
   ic.max_triangles = config.max_triangles;
   ImportedMesh m = import_mesh(path, ic);
   check_extent(m.bounds, path);
-  check_memory(path, MemoryModel::scene(m.triangles.size(), 0, 0), config);
+  std::uint64_t texture_bytes = m.uvs.size() * sizeof(TexCoords) * 2;  // as read, and built
+  for (const Texture& t : m.textures) texture_bytes += t.texels.size();
+  check_memory(path, MemoryModel::scene(m.triangles.size(), 0, 0) + texture_bytes, config);
   SceneDescription d;
   d.prims = std::move(m.triangles);
   d.materials = std::move(m.materials);
-  d.env.camera = frame_camera(m.bounds);
-  d.env.lights = default_lights(m.bounds, d.env.camera);
+  d.uvs = std::move(m.uvs);
+  d.textures = std::move(m.textures);
+  d.cameras = std::move(m.cameras);
+  d.warnings = std::move(m.dropped);
+  d.env.camera = d.cameras.empty() ? frame_camera(m.bounds) : d.cameras.front().camera;
+  d.default_lights = m.lights.empty();
+  d.env.lights = d.default_lights ? default_lights(m.bounds, d.env.camera) : std::move(m.lights);
   return d;
 }
 
@@ -51,6 +66,9 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   SceneDescription d = ext == ".json" ? read_scene_json(path, config) : mesh_scene(path, config);
   const auto t1 = Clock::now();
   Environment env = std::move(d.env);
+  std::vector<NamedCamera> cameras = std::move(d.cameras);
+  std::vector<std::string> warnings = std::move(d.warnings);
+  const bool defaults = d.default_lights;
   if (config.on_phase) config.on_phase("building and baking " + path);
   double bake_seconds = 0.0;
   BuildConfig build;
@@ -58,10 +76,61 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   AnyHierarchy h = build_hierarchy(std::move(d), build);
   const auto t2 = Clock::now();
   LoadedScene s{path, std::move(h), std::move(env)};
+  s.cameras = std::move(cameras);
+  s.warnings = std::move(warnings);
+  s.default_lights = defaults;
   s.load_seconds = std::chrono::duration<double>(t1 - t0).count();
   s.bake_seconds = bake_seconds;
   s.build_seconds = std::max(0.0, std::chrono::duration<double>(t2 - t1).count() - bake_seconds);
   return s;
+}
+
+void choose_camera(LoadedScene& scene, const CameraChoice& choice) {
+  Camera c = scene.env.camera;
+  if (!choice.camera.empty()) {
+    const std::string& want = choice.camera;
+    std::string list;
+    const NamedCamera* found = nullptr;
+    for (std::size_t i = 0; i < scene.cameras.size(); ++i) {
+      if (scene.cameras[i].name == want && !found) found = &scene.cameras[i];
+      list +=
+          (i ? ", " : "") + std::to_string(i) + " '" + one_line(scene.cameras[i].name, 60) + "'";
+    }
+    if (!found && !want.empty() && want.size() < 10 &&
+        want.find_first_not_of("0123456789") == std::string::npos &&
+        std::stoul(want) < scene.cameras.size())
+      found = &scene.cameras[std::stoul(want)];
+    if (!found)
+      throw InputError("--camera " + one_line(want, 60) + ": " +
+                       (scene.cameras.empty()
+                            ? scene.name + " defines no cameras (--eye, --look-at, --up and "
+                                           "--fov set the view of any scene)"
+                            : "no such camera in " + scene.name + " (cameras: " + list + ")"));
+    c = found->camera;
+  }
+  if (choice.eye) c.position = *choice.eye;
+  if (choice.look_at) c.look_at = *choice.look_at;
+  if (choice.up) c.up = *choice.up;
+  if (choice.fov_deg) {
+    if (!(*choice.fov_deg > 0.0f && *choice.fov_deg < 180.0f))
+      throw InputError("--fov " + JsonReader::format(*choice.fov_deg) +
+                       ": expected a vertical field of view in degrees, > 0 and < 180");
+    c.vfov_deg = *choice.fov_deg;
+  }
+  const Vec3 dir = c.look_at - c.position;
+  if (!(length(dir) > 0.0f))
+    throw InputError("--eye/--look-at: the eye is at the look-at point (no view direction)");
+  if (!(length(cross(normalize(dir), c.up)) > 1e-6f * length(c.up)))
+    throw InputError("--up: the up vector is zero or along the view direction");
+  const bool changed = c.position != scene.env.camera.position ||
+                       c.look_at != scene.env.camera.look_at || c.up != scene.env.camera.up ||
+                       c.vfov_deg != scene.env.camera.vfov_deg;
+  if (!changed) return;
+  scene.env.camera = c;
+  if (scene.default_lights) {
+    const Bbox b = std::visit([](const auto& h) { return h.bounds(h.root()); }, scene.hierarchy);
+    scene.env.lights = default_lights(b, c);
+  }
 }
 
 LoadedScene load_scene(const std::string& spec, const Params& params,

@@ -4,6 +4,7 @@
 /// top layer of the library: it decides how a described scene is built (explicit or
 /// instanced) and composes the readers of io/ with the builders of hierarchy/.
 
+#include <optional>
 #include <string>
 
 #include "amalgam/hierarchy/build/build.h"
@@ -25,6 +26,21 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
 /// and bakes its hierarchy (build_hierarchy). Sets load_seconds (reading), build_seconds and
 /// bake_seconds (the bake apart from the rest of the build).
 LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config = {});
+
+/// The view asked for on the command line: one of the scene file's cameras (glTF) by name or
+/// index, then any of its fields replaced.
+struct CameraChoice {
+  std::string camera;  ///< a name, else a 0-based index, of LoadedScene::cameras; empty: default
+  std::optional<Vec3> eye, look_at, up;
+  std::optional<float> fov_deg;  ///< vertical field of view
+};
+
+/// Applies `choice` to `scene.env.camera`; default lights (LoadedScene::default_lights) follow
+/// the camera. Call before content_hash is taken, so that a checkpoint records the view.
+/// Throws InputError: `--camera X` naming no camera of the scene (the message lists those it
+/// has), a field of view outside (0, 180) degrees, the eye at the look-at point, or an up
+/// vector along the view direction.
+void choose_camera(LoadedScene& scene, const CameraChoice& choice);
 
 /// Loads `spec`. Throws InputError (one line naming the scene and the problem) on bad input,
 /// including a scene file or mesh that would take more than `config.max_bytes` (checked before

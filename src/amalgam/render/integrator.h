@@ -65,7 +65,7 @@ class Integrator {
     }
     Vec3 end = env_.background;
     if (hit.kind == TraceHit::Kind::kPrimitive) {
-      const Surface surf = h_.surface(hit.id);
+      const Surface surf = surface_at(h_, hit.id, hit.surf);
       end = direct(primary, hit.surf, hit.surf.normal, surf, key, shadow_stream);
       r.normal += facing(hit.surf.normal, wo) * through;
       r.albedo += surf.colour * through;

@@ -2,6 +2,7 @@
 
 #include <bit>
 #include <chrono>
+#include <cstring>
 
 #include "amalgam/math/random.h"
 
@@ -31,7 +32,21 @@ struct Hasher {
     add(static_cast<std::uint64_t>(s.size()));
     for (unsigned char c : s) add(static_cast<std::uint64_t>(c));
   }
-  void add(const Surface& m) { add(m.colour), add(m.reflectance), add(m.shininess); }
+  void add(const Surface& m) {
+    add(m.colour), add(m.reflectance), add(m.shininess);
+    if (m.texture >= 0) add(static_cast<std::uint64_t>(m.texture));  // untextured: as before
+  }
+  void add(const Texture& t) {
+    add(static_cast<std::uint64_t>(t.width)), add(static_cast<std::uint64_t>(t.height));
+    add(static_cast<std::uint64_t>(t.texels.size()));
+    std::size_t i = 0;
+    for (; i + 8 <= t.texels.size(); i += 8) {  // eight bytes at a time: textures are large
+      std::uint64_t w;
+      std::memcpy(&w, t.texels.data() + i, 8);
+      add(w);
+    }
+    for (; i < t.texels.size(); ++i) add(static_cast<std::uint64_t>(t.texels[i]));
+  }
   void add(const Primitive& p) {
     add(static_cast<std::uint64_t>(p.kind)), add(static_cast<std::uint64_t>(p.material));
     add(p.a), add(p.b), add(p.c), add(p.radius);
@@ -41,6 +56,15 @@ struct Hasher {
     for (const Primitive& p : e.prims) add(p);
     add(static_cast<std::uint64_t>(e.materials.size()));
     for (const Surface& m : e.materials) add(m);
+    if (!e.uvs.empty()) {  // textured: coordinates and images (absent before textures existed)
+      add(static_cast<std::uint64_t>(e.uvs.size()));
+      for (const TexCoords& c : e.uvs)
+        for (int k = 0; k < 3; ++k) add(c.u[k]), add(c.v[k]);
+    }
+    if (e.textures && !e.textures->empty()) {
+      add(static_cast<std::uint64_t>(e.textures->size()));
+      for (const Texture& t : *e.textures) add(t);
+    }
   }
 };
 

@@ -10,6 +10,7 @@
 #include "amalgam/builtin/catalog.h"
 #include "amalgam/hierarchy/explicit.h"
 #include "amalgam/hierarchy/instanced.h"
+#include "amalgam/scene/description.h"
 
 namespace amalgam {
 
@@ -27,6 +28,12 @@ struct LoadedScene {
   double bake_seconds = 0.0;   ///< baking the amalgams' appearances
   /// For builtin scenes: the parameters as applied (Params::applied); part of content_hash.
   std::string params{};
+  /// The cameras the scene file defines (glTF), env.camera being the chosen one.
+  std::vector<NamedCamera> cameras{};
+  /// env.lights are the default lights for env.camera (they follow a camera chosen later).
+  bool default_lights = false;
+  /// What the scene file holds that is not rendered, one line each (the CLI prints them).
+  std::vector<std::string> warnings{};
 
   HierarchyInfo info() const {
     return std::visit([](const auto& h) { return h.info(); }, hierarchy);
@@ -36,8 +43,8 @@ struct LoadedScene {
 /// A 64-bit hash of everything the scene renders: its lights, camera and background, and its
 /// geometry (for stored hierarchies every primitive, material and instance transform, field
 /// by field; for the builtin scenes their name and parameters as applied, which determine
-/// them). Two scenes with the same hash render the same image (up to hash collisions): what a
-/// checkpoint is resumed against.
+/// them; textures and texture coordinates when there are any). Two scenes with the same hash render
+/// the same image (up to hash collisions): what a checkpoint is resumed against.
 std::uint64_t content_hash(const LoadedScene& scene);
 
 /// A builtin scene (builtin/catalog.h) ready to render; sets load_seconds.

@@ -3,6 +3,7 @@
 
 #include <numbers>
 
+#include "amalgam/hierarchy/hierarchy.h"
 #include "amalgam/scene/scene.h"
 #include "amalgam/util/isa.h"
 
@@ -22,6 +23,17 @@ inline Vec3 brdf(const Surface& s, Vec3 n, Vec3 wi, Vec3 wo) {
     f += Vec3{spec, spec, spec};
   }
   return f;
+}
+
+/// The surface of primitive `id` of `h` at hit `s` (found by the counted test): textured
+/// where the hierarchy has textures (`surface_at`), else the primitive's material.
+template <Hierarchy H>
+inline Surface surface_at(const H& h, PrimId id, const SurfaceHit& s) {
+  if constexpr (requires { h.surface_at(id, s); }) {
+    return h.surface_at(id, s);
+  } else {
+    return h.surface(id);
+  }
 }
 
 AMALGAM_ISA_END

@@ -15,9 +15,12 @@ namespace amalgam {
 /// How a surface reflects light: Lambertian diffuse plus a normalised Blinn-Phong lobe.
 /// No mirror or refraction rays are ever spawned (the paper's setting).
 struct Surface {
-  Vec3 colour{0.8f, 0.8f, 0.8f};  ///< diffuse albedo, linear RGB
+  Vec3 colour{0.8f, 0.8f, 0.8f};  ///< diffuse albedo, linear RGB (with a texture: its factor)
   float reflectance = 0.0f;       ///< specular weight in [0, 1]
   float shininess = 32.0f;        ///< Blinn-Phong exponent
+  /// Base-colour texture (scene/texture.h), an index into the hierarchy's textures, or -1.
+  /// The albedo at a hit is `colour` times the texture sampled at the hit's coordinates.
+  std::int32_t texture = -1;
 };
 
 enum class PrimKind : std::uint8_t { kTriangle, kSphere, kBox };

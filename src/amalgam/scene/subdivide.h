@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "amalgam/scene/scene.h"
+#include "amalgam/scene/texture.h"
 
 namespace amalgam {
 
@@ -11,5 +12,8 @@ namespace amalgam {
 /// 4^levels times the triangles, each keeping its material. `triangles` must all be
 /// kTriangle; levels <= 0 returns them unchanged.
 std::vector<Primitive> subdivide(const std::vector<Primitive>& triangles, int levels);
+
+/// The texture coordinates of the triangles `subdivide` makes, in the same order.
+std::vector<TexCoords> subdivide(const std::vector<TexCoords>& uvs, int levels);
 
 }  // namespace amalgam

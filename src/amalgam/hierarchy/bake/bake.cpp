@@ -53,9 +53,10 @@ std::vector<int> node_levels(const std::vector<ExplicitNode>& nodes) {
 
 /// Exact bake of node `id`: random lines traced (closest hit) against its subtree.
 /// `orientation`: closed_orientation of the hierarchy's primitives (0: triangles have no
-/// known outside, so the result is never kOriented when one is hit).
+/// known outside, so the result is never kOriented when one is hit). `colours`: each
+/// primitive's bake colour when the hierarchy is textured (else empty: the materials').
 BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeConfig& cfg,
-                      int orientation) {
+                      int orientation, const std::vector<Vec3>& colours) {
   const int rays = std::max(cfg.rays, 1);
   const Bbox box = h.nodes[id].bounds;
   Vec3 colour{};
@@ -100,7 +101,7 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
     if (!best) continue;
     ++hits;
     const Surface& m = h.materials[h.prims[best_prim].material];
-    colour += m.colour;
+    colour += colours.empty() ? m.colour : colours[best_prim];
     spec += m.reflectance;
     shine += m.shininess;
     normals.add(best->normal, 1.0f);
@@ -127,6 +128,21 @@ void bake(ExplicitHierarchy& h, const BakeConfig& config) {
   const int orientation =
       h.prims.size() <= config.orient_max_triangles ? closed_orientation(h.prims) : 0;
   h.appearances.assign(n, Appearance{});
+  // Textured: each primitive's colour, its texture's mean over its coordinates, computed once
+  // (every exact bake above it would otherwise average the texture again).
+  std::vector<Vec3> colours;
+  if (h.textures && !h.textures->empty()) {
+    colours.resize(h.prims.size());
+    auto fill = [&](std::size_t b, std::size_t e) {
+      for (std::size_t p = b; p < e; ++p) colours[p] = h.bake_colour(p);
+    };
+    if (config.parallel && colours.size() > 4096)
+      tbb::parallel_for(
+          tbb::blocked_range<std::size_t>(0, colours.size(), 1024),
+          [&](const tbb::blocked_range<std::size_t>& r) { fill(r.begin(), r.end()); });
+    else
+      fill(0, colours.size());
+  }
   std::vector<NormalTensor> tensors(n);
   std::vector<std::uint64_t> prims_below(n, 0);
   const std::vector<int> level = node_levels(h.nodes);
@@ -142,7 +158,7 @@ void bake(ExplicitHierarchy& h, const BakeConfig& config) {
     const ExplicitNode& node = h.nodes[i];
     BakeResult r;
     if (node.leaf || prims_below[i] <= static_cast<std::uint64_t>(config.exact_prims)) {
-      r = bake_exact(h, static_cast<std::uint32_t>(i), config, orientation);
+      r = bake_exact(h, static_cast<std::uint32_t>(i), config, orientation, colours);
     } else {
       BakeChild kids[kMaxChildren];
       AMALGAM_CHECK(node.count <= kMaxChildren,

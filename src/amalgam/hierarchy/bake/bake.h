@@ -35,7 +35,8 @@ struct BakeConfig {
 /// Bakes every node of `h` bottom-up, one level at a time. A node with at most
 /// `config.exact_prims` primitives below it is baked exactly: `config.rays` random lines
 /// through its box are traced against its subtree; opacity = fraction that hit, colour = mean
-/// colour of the surfaces hit, normal = dominant axis of their normals. A larger node combines
+/// colour of the surfaces hit (a textured triangle: its colour times its texture's mean over
+/// the triangle's texture coordinates), normal = dominant axis of their normals. A larger node combines
 /// its children (`bake_from_children`). Sets `h.appearances`, `h.root_normals` and rebuilds the
 /// SIMD child boxes (`build_wide`).
 void bake(ExplicitHierarchy& h, const BakeConfig& config = {});

@@ -48,8 +48,12 @@ std::vector<ExplicitNode> explicit_nodes(const SahTree& t) {
 }  // namespace
 
 ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surface> materials,
-                                 const BuildConfig& config) {
+                                 const BuildConfig& config, std::vector<TexCoords> uvs,
+                                 std::shared_ptr<const std::vector<Texture>> textures) {
+  AMALGAM_CHECK(uvs.empty() || uvs.size() == prims.size(),
+                "build_explicit: texture coordinates for some primitives only");
   ExplicitHierarchy h;
+  h.textures = std::move(textures);
   h.materials = std::move(materials);
   if (h.materials.empty()) h.materials.push_back(Surface{});
   std::vector<Bbox> boxes(prims.size());
@@ -68,6 +72,10 @@ ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surfa
   h.prims.resize(prims.size());
   each(prims.size(), [&](std::size_t i) { h.prims[i] = prims[t.order[i]]; });
   prims = {};
+  if (!uvs.empty()) {
+    h.uvs.resize(uvs.size());
+    each(uvs.size(), [&](std::size_t i) { h.uvs[i] = uvs[t.order[i]]; });
+  }
   h.nodes = explicit_nodes(t);
   h.levels = t.depth + 2;  // primitives one level below the deepest leaf
   BakeConfig bc = config.bake;
