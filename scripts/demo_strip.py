@@ -46,47 +46,53 @@ def main():
     cost_norm = LogNorm(vmin=lo, vmax=hi)
     has_level = [(src / f"{c['name']}-level.pfm").exists() for c in columns]
     rows = 3 if any(has_level) else 2
-    fig, axes = plt.subplots(rows, len(columns), figsize=(3.1 * len(columns), 2.55 * rows + 0.9),
+    fig, axes = plt.subplots(rows, len(columns), figsize=(3.1 * len(columns) + 1.3, 2.42 * rows + 0.7),
                              squeeze=False, constrained_layout=True)
-    max_level = 0
-    levels = []
-    for c, ok in zip(columns, has_level):
-        lv = read_pfm(src / f"{c['name']}-level.pfm") if ok else None
-        levels.append(lv)
-        if lv is not None and np.any(lv >= 0):
-            max_level = max(max_level, int(np.nanmax(lv)))
-    level_cmap = plt.get_cmap("turbo", max_level + 2)
-    level_norm = BoundaryNorm(np.arange(-1.5, max_level + 1.5), level_cmap.N)
+    # Level images: amalgam levels (rounded: a pixel's samples may have rendered several) on
+    # one colour scale over every column, primitives grey, nothing hit white.
+    levels = [read_pfm(src / f"{c['name']}-level.pfm") if ok else None
+              for c, ok in zip(columns, has_level)]
+    rendered = [np.rint(lv[lv >= 0]) for lv in levels if lv is not None]
+    rendered = [r for r in rendered if r.size]
+    lmin = int(min(r.min() for r in rendered)) if rendered else 0
+    lmax = int(max(r.max() for r in rendered)) if rendered else 0
+    level_cmap = plt.get_cmap("plasma", lmax - lmin + 1)
+    level_norm = BoundaryNorm(np.arange(lmin - 0.5, lmax + 1.5), level_cmap.N)
     cost_im = level_im = None
     for j, c in enumerate(columns):
         stats = json.loads((src / f"{c['name']}.json").read_text())
         per_ray = stats["per_primary_ray"]["mean"]
-        seconds = stats.get("seconds", stats.get("render_seconds"))
+        t = stats["time_s"]
         axes[0][j].imshow(mpimg.imread(src / f"{c['name']}.png"))
         axes[0][j].set_title(c["title"], fontsize=9)
         cost_im = axes[1][j].imshow(costs[j], cmap="viridis", norm=cost_norm)
-        label = f"{per_ray:.1f} tests per ray"
-        if isinstance(seconds, (int, float)):
-            label += f", {seconds:.2f} s"
-        axes[1][j].set_xlabel(label, fontsize=9)
+        axes[1][j].set_xlabel(f"{per_ray:.1f} tests per ray\nrender {t['render']:.2f} s, "
+                              f"load+build+bake {t['load'] + t['build'] + t.get('bake', 0):.2f} s",
+                              fontsize=9)
         if rows == 3:
-            if levels[j] is not None and c["renderer"] == "scale-sensitive":
-                lv = np.where(np.isnan(levels[j]), -1, levels[j])
-                level_im = axes[2][j].imshow(np.rint(lv), cmap=level_cmap, norm=level_norm,
-                                             interpolation="nearest")
-                axes[2][j].set_xlabel("level rendered (-1: primitive or sky)", fontsize=8)
+            lv = levels[j]
+            if lv is not None and c["renderer"] == "scale-sensitive":
+                rgb = np.ones(lv.shape + (3,))
+                rgb[lv <= -1.5] = 0.6  # primitives
+                mask = lv >= 0
+                rgb[mask] = level_cmap(level_norm(np.rint(lv[mask])))[:, :3]
+                axes[2][j].imshow(rgb, interpolation="nearest")
+                level_im = plt.cm.ScalarMappable(norm=level_norm, cmap=level_cmap)
+                axes[2][j].set_xlabel(f"an amalgam rendered in {100.0 * mask.mean():.0f} % of "
+                                      "pixels\n(grey: a primitive)", fontsize=9)
             else:
                 axes[2][j].text(0.5, 0.5, "traditional:\nevery bounding volume\nis traversed,\n"
-                                "never rendered", ha="center", va="center", fontsize=9,
+                                "none is rendered", ha="center", va="center", fontsize=9,
                                 transform=axes[2][j].transAxes)
+                axes[2][j].axis("off")
         for ax in axes[:, j]:
             ax.set_xticks([])
             ax.set_yticks([])
     fig.colorbar(cost_im, ax=list(axes[1]), shrink=0.9,
                  label="intersection tests per pixel (log)")
     if level_im is not None:
-        fig.colorbar(level_im, ax=list(axes[2]), shrink=0.9, label="level",
-                     ticks=range(-1, max_level + 1, max(1, (max_level + 1) // 8)))
+        fig.colorbar(level_im, ax=list(axes[2]), shrink=0.9, label="level rendered",
+                     ticks=range(lmin, lmax + 1, max(1, (lmax - lmin + 1) // 8)))
     fig.suptitle(strip["title"], fontsize=11)
     tmp = out.with_suffix(".tmp.png")
     fig.savefig(tmp, dpi=110)
