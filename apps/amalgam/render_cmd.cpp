@@ -303,7 +303,8 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
              {"amalgam:cost", "cost.Y: intersection tests per pixel, total over its spp samples"},
              {"amalgam:level", "level.Y: level of the rendered amalgams (majority of samples); " +
                                    std::to_string(kLevelPrimitive) + ": primitives; " +
-                                   std::to_string(kLevelNothing) + ": nothing hit"}});
+                                   std::to_string(kLevelNothing) + ": nothing hit"}},
+            !embree);
         if (top > 16777216.0)
           std::cerr << "amalgam: warning: " << extra.out << ": a pixel holds " << top
                     << " tests, beyond 2^24: its cost.Y is rounded to float32 (the stats JSON "

@@ -44,8 +44,8 @@ std::vector<std::string> render_exr_channels() {
           "N.X", "N.Y", "N.Z", "albedo.R", "albedo.G", "albedo.B"};
 }
 
-double write_render_exr(const std::string& path, const RenderOutput& r,
-                        const ImageText& attributes) {
+double write_render_exr(const std::string& path, const RenderOutput& r, const ImageText& attributes,
+                        bool counted) {
   // The totals as float32: exact integers up to 2^24 per pixel.
   std::vector<float> cost(r.tests.size());
   double top = 0.0;
@@ -63,6 +63,7 @@ double write_render_exr(const std::string& path, const RenderOutput& r,
                                            vec(r.albedo, 0), vec(r.albedo, 1), vec(r.albedo, 2)};
   std::vector<codec::ExrChannel> channels;
   for (std::size_t k = 0; k < names.size(); ++k) {
+    if (!counted && names[k] == "cost.Y") continue;
     const bool packed = names[k] == "cost.Y" || names[k] == "level.Y" || names[k] == "Z";
     channels.push_back({names[k], bases[k], packed ? sizeof(float) : sizeof(Vec3)});
   }

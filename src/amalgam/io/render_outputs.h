@@ -19,9 +19,10 @@ std::vector<std::string> render_exr_channels();
 /// RGB-only readers see it), cost.Y (intersection tests, total over the pixel's samples),
 /// level.Y, Z (depth), N.X, N.Y, N.Z (normal), albedo.R, albedo.G, albedo.B, with `attributes`
 /// as string attributes of the header. Returns the largest cost value written; totals above
-/// 2^24 are not exact in float32 (the caller warns).
-double write_render_exr(const std::string& path, const RenderOutput& r,
-                        const ImageText& attributes);
+/// 2^24 are not exact in float32 (the caller warns). `counted` false (a tracer that counts no
+/// tests, e.g. Embree): no cost.Y channel, rather than one of zeros.
+double write_render_exr(const std::string& path, const RenderOutput& r, const ImageText& attributes,
+                        bool counted = true);
 
 /// The cost image: .png in viridis on the log scale of `range` (tests per primary sample, the
 /// mean over the pixel's samples) with a colour bar appended below (colormap.h) and the range
