@@ -2,9 +2,11 @@
 # `cmake --install` gives a usable package: a consumer program configured with only
 # find_package(amalgam) builds against the installed headers and libraries, gets none of our
 # build flags (warnings, -Werror, ISA defines), and renders exactly what the CLI renders.
-# Usage: install_test.sh BUILD_DIR SOURCE_DIR
+# Usage: install_test.sh BUILD_DIR SOURCE_DIR [CXX_FLAGS LINKER_FLAGS]
+# The flags are the build's own sanitizer flags, if any: a library built with ASan links only
+# into a program built with it (the consumer gets exactly these, nothing else of ours).
 set -euo pipefail
-build=$1 src=$2
+build=$1 src=$2 cxx_flags=${3:-} link_flags=${4:-}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cmake --install "$build" --prefix "$tmp/prefix" >/dev/null
@@ -14,7 +16,8 @@ for f in bin/amalgam bin/amalgam-import include/amalgam/render/render.h \
 done
 unset CXXFLAGS CMAKE_CXX_COMPILER_LAUNCHER
 cmake -S "$src/tests/install/consumer" -B "$tmp/consumer" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_PREFIX_PATH="$tmp/prefix" -DCMAKE_EXPORT_COMPILE_COMMANDS=ON >/dev/null
+  -DCMAKE_PREFIX_PATH="$tmp/prefix" -DCMAKE_EXPORT_COMPILE_COMMANDS=ON \
+  -DCMAKE_CXX_FLAGS="$cxx_flags" -DCMAKE_EXE_LINKER_FLAGS="$link_flags" >/dev/null
 cmake --build "$tmp/consumer" >/dev/null
 if grep -E -- '-Werror|-Wpedantic|-mavx|AMALGAM_BUILD_AVX2_COPY|AMALGAM_IMPORT_HELPER' \
      "$tmp/consumer/compile_commands.json"; then
