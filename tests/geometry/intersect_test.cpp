@@ -88,9 +88,34 @@ TEST(RayTriangle, SharedEdgesAndVerticesAreWatertight) {
     const Vec3 o = centre + Vec3{u(rng) - 0.5f, u(rng) - 0.5f, 2.0f};
     const Ray r = Ray::make(o, centre - o);
     bool hit = false;
-    for (int k = 0; k < 8; ++k) hit |= bool(intersect_triangle(r, centre, ring[k], ring[(k + 1) % 8]));
+    for (int k = 0; k < 8; ++k)
+      hit |= bool(intersect_triangle(r, centre, ring[k], ring[(k + 1) % 8]));
     ASSERT_TRUE(hit) << "ray " << i << " slipped through the shared vertex";
   }
+}
+
+TEST(RayTriangle, SmallTriangleFarAwayIsHit) {
+  // Half-millimetre triangles 240 m from the origin, as a subdivided Wuson seen across
+  // scenes/demo-field-fine.json: every ray aimed well inside one hits it. (The rounding bound on
+  // t, which grows with the distance, used to exceed t itself and reject them.)
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0, 1);
+  const Vec3 origin{0, 14, 135};
+  int hits = 0;
+  const int n = 2000;
+  for (int i = 0; i < n; ++i) {
+    const Vec3 centre{200.0f * (u(rng) - 0.5f), 0.5f * u(rng), -100.0f - 10.0f * u(rng)};
+    const Vec3 a = centre, b = centre + Vec3{5e-4f, 1e-4f * u(rng), 0},
+               c = centre + Vec3{1.5e-4f * u(rng), 5e-4f, 2.5e-4f * (u(rng) - 0.5f)};
+    const float s = 0.2f + 0.3f * u(rng), t = 0.2f + 0.3f * u(rng);
+    const Vec3 target = a + (b - a) * s + (c - a) * t;
+    const auto h = intersect_triangle(Ray::make(origin, normalize(target - origin)), a, b, c);
+    if (h) {
+      ++hits;
+      EXPECT_NEAR(h->t, length(target - origin), 1e-3f);
+    }
+  }
+  EXPECT_EQ(hits, n);
 }
 
 TEST(RayTriangle, DegenerateTriangleNeverHitsNorCrashes) {

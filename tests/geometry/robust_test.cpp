@@ -585,6 +585,33 @@ TEST(ShadowAcne, ClosedMeshLitFromOutsideHasNoSelfShadowing) {
   }
 }
 
+TEST(ShadowAcne, InstancedMeshFarFromTheOriginHasNoSelfShadowing) {
+  // A convex closed mesh of 1 cm triangles as a rotated instance 100 m from the world origin,
+  // as the Wusons of scenes/demo-field-fine.json: a shadow ray leaves its hit point by the
+  // point's world error bound, but re-enters object space through the instance's inverse
+  // transform, whose rounding (of the distance from the world origin, and turned into another
+  // axis by the rotation) put it behind its own triangle.
+  const Mesh m = icosphere(5).transformed(0.5f, {});
+  std::vector<ExplicitHierarchy> meshes;
+  meshes.push_back(build_explicit(m.primitives(), {Surface{}}));
+  const Vec3 where{97.3f, 0.21f, 0.37f};
+  const Transform place = AffineD::translate(where).as<float>() * Transform::rotate(1, 57.0);
+  const Vec3 light = normalize(Vec3{0.45f, -1.0f, -0.6f});
+  Camera cam;
+  cam.position = where + Vec3{0.0f, 0.4f, 2.5f};
+  cam.look_at = where;
+  LoadedScene s{"instanced sphere", build_instanced(std::move(meshes), {Instance{place, 0}}),
+                sun_only(light, cam)};
+  std::vector<Ray> rays;
+  const int n = 200 / (kRayScale == 1 ? 1 : 4);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) rays.push_back(cam.generate(x + 0.5f, y + 0.5f, n, n));
+  const LitCheck r = check_lit(s, light, rays, 1e-3f, [](Vec3) { return true; });
+  EXPECT_GT(r.hits, rays.size() / 20);
+  EXPECT_EQ(r.dark, 0u) << r.dark << " of " << r.hits
+                        << " lit points shadowed by their own surface, first " << r.first_dark;
+}
+
 TEST(ShadowAcne, FarPlaneAtGrazingLightIsFullyLitWhereUnoccluded) {
   // A tilted quad 1e5 units from the origin, a closed sphere mesh resting above it, the light
   // 3 degrees above the plane. Every point of the quad outside the sphere's shadow is lit.

@@ -68,13 +68,18 @@ Appearance InstancedHierarchy::appearance(NodeId n) const {
   return a;
 }
 
+Vec3 InstancedHierarchy::object_origin(const InstanceData& in, Vec3 o) {
+  const Vec3 rel{o.x - in.to_world.m[0][3], o.y - in.to_world.m[1][3], o.z - in.to_world.m[2][3]};
+  return in.to_object.vector(rel);
+}
+
 std::optional<SurfaceHit> InstancedHierarchy::intersect(PrimId p, const Ray& ray) const {
   const InstanceData& in = instances[slot(p) - 1];
   const ExplicitHierarchy& mesh = meshes[in.mesh];
   if (in.identity) return mesh.intersect(local(p), ray);
   // Object-space ray with the direction left unnormalised: t means the same in both spaces.
   const Ray obj =
-      Ray::make(in.to_object.point(ray.origin), in.to_object.vector(ray.dir), ray.tmin, ray.tmax);
+      Ray::make(object_origin(in, ray.origin), in.to_object.vector(ray.dir), ray.tmin, ray.tmax);
   auto hit = mesh.intersect(local(p), obj);
   if (!hit) return hit;
   SurfaceHit w;
@@ -93,9 +98,43 @@ std::optional<SurfaceHit> InstancedHierarchy::intersect(PrimId p, const Ray& ray
     err[i] = (gamma(3) + 1.0f) * dot(in.abs_rows[i], hit->p_error) +
              gamma(3) * (dot(in.abs_rows[i], ap) + std::fabs(in.to_world.m[i][3]));
   }
-  w.p_error = err;
+  w.p_error = err + retransform_error(in, w.p, err);
   w.b1 = hit->b1, w.b2 = hit->b2;  // an affine map keeps barycentrics
   return w;
+}
+
+Vec3 InstancedHierarchy::retransform_error(const InstanceData& in, Vec3 p, Vec3 err) {
+  // A ray leaving p starts at o = offset_ray_origin(p, err', n) (err' the returned bound) and
+  // is taken to object space as Q (o - t) (object_origin; Q = to_object's matrix, t the
+  // translation): off from the exact M^-1 (o - t) by up to gamma(5) |Q| |o - t| per component
+  // (1 rounding of o - t, 3 of the dot product, 1 of Q's entries, rounded from the exact inverse
+  // computed in double, whose own error of about cond(M) 1e-16 is negligible), gamma(8) with
+  // the rounding of this bound's own float evaluation; |M| times that in world space. The
+  // offset moves o from p by at most D = the sum of err' (offset_ray_origin: |n| d <= sum err'),
+  // plus the rounding of p + n d and the nextafter step (< 4 ulp(p) / 2): |o - t| <= |p - t| +
+  // gamma(4) |p| + D. With e(x) = gamma(8) |M| |Q| x: err' = err + e(|p - t| + gamma(4) |p|) +
+  // k D, k = e(1, 1, 1), and D = sum err', solved for D.
+  Vec3 qa, qs;  // |Q| a with a = |p - t| + gamma(4) |p|, and |Q| 1
+  Vec3 a;
+  for (int j = 0; j < 3; ++j)
+    a[j] = std::fabs(p[j] - in.to_world.m[j][3]) + gamma(4) * std::fabs(p[j]);
+  for (int j = 0; j < 3; ++j) {
+    const Vec3 row = abs(Vec3{in.to_object.m[j][0], in.to_object.m[j][1], in.to_object.m[j][2]});
+    qa[j] = dot(row, a);
+    qs[j] = row.x + row.y + row.z;
+  }
+  Vec3 e, k;
+  for (int i = 0; i < 3; ++i) {
+    e[i] = gamma(8) * dot(in.abs_rows[i], qa);
+    k[i] = gamma(8) * dot(in.abs_rows[i], qs);
+  }
+  // D, rounded up by (1 + gamma(4)) for its own float evaluation. k is about 70 cond(M) 2^-24:
+  // below 1/2 unless M is within a few parts in a million of singular, where a float transform
+  // keeps no digits anyway (then D is taken as twice its first term: no longer a bound).
+  const float ksum = k.x + k.y + k.z;
+  const float grow = ksum < 0.5f ? 1.0f / (1.0f - ksum) : 2.0f;
+  const float d = (err.x + err.y + err.z + e.x + e.y + e.z) * grow * (1.0f + gamma(4));
+  return e + k * d;
 }
 
 Primitive InstancedHierarchy::primitive(PrimId p) const {

@@ -93,6 +93,19 @@ class InstancedHierarchy {
   /// The world box of the transformed box `b` of instance `in` (conservative by a few ulps).
   static Bbox world_box(const InstanceData& in, const Bbox& b);
 
+  /// A world ray origin `o` in the object space of instance `in`: M^-1 (o - t) evaluated as
+  /// to_object's matrix times (o - t), not as to_object.point(o) = M^-1 o - M^-1 t. For an
+  /// origin near the instance (a shadow ray leaving it) o - t is exact or nearly, and the result
+  /// is off by the rounding of the distance from the instance, not from the world origin (there
+  /// 1e-5 m 100 m out, as much as a subdivided Wuson's triangles are from a ray's silhouette).
+  static Vec3 object_origin(const InstanceData& in, Vec3 o);
+
+  /// What `intersect` adds to the error bound `err` of a world hit point `p` of instance `in`:
+  /// the error of taking the origin of a ray that leaves p (offset_ray_origin) back into object
+  /// space in float, in world units, so that the offset keeps that origin in front of the
+  /// surface in object space too (a shadow ray otherwise meets its own triangle again).
+  static Vec3 retransform_error(const InstanceData& in, Vec3 p, Vec3 err);
+
   /// The children of node `n` for the traversal's SIMD test (hierarchy/wide.h): top-level
   /// nodes' and instance roots' world boxes as stored; inside an instance, the world box of
   /// each child's transformed box, computed four at a time with the float operations of

@@ -30,14 +30,17 @@ struct UserGeometry;
 struct EmbreeMesh {
   RTCScene scene = nullptr;
   std::vector<std::uint64_t> ids[2];
-  std::unique_ptr<UserGeometry> user;
+  std::unique_ptr<UserGeometry> user, triangles;
 };
 
-/// What a user-geometry callback needs: the hierarchy (of type H, see user_intersect), the
-/// ids of its primitives and their (object-space) bounds.
+/// What a user-geometry callback or the triangles' occlusion filter needs: the hierarchy (of
+/// type H, see user_intersect), the ids of its primitives and (user geometry) their
+/// object-space bounds.
 struct UserGeometry {
   const void* hierarchy = nullptr;
-  const std::vector<std::uint64_t>* ids = nullptr;
+  /// The mesh's ids vector's data: unlike the vector itself (an element of Impl::meshes, which
+  /// moves as that grows), its buffer stays put once filled.
+  const std::uint64_t* ids = nullptr;
   std::vector<Bbox> bounds;
 };
 
@@ -60,7 +63,7 @@ template <class H>
 std::optional<SurfaceHit> user_test(const UserGeometry& g, const RTCIntersectContext* ctx,
                                     unsigned prim, float tfar) {
   const auto* q = reinterpret_cast<const QueryContext*>(ctx);
-  std::uint64_t id = (*g.ids)[prim];
+  std::uint64_t id = g.ids[prim];
   if constexpr (kInstanced<H>) {
     id = InstancedHierarchy::id(ctx->instID[0] + 1ull, static_cast<std::uint32_t>(id));
   }
@@ -98,6 +101,28 @@ void user_occluded(const RTCOccludedFunctionNArguments* a) {
     if (!a->valid[i]) continue;
     float& tfar = RTCRayN_tfar(a->ray, a->N, i);
     if (user_test<H>(g, a->context, a->primID, tfar)) tfar = -kInfinity;  // Embree: occluded
+  }
+}
+
+/// The triangles' occlusion filter: a shadow ray's hit on a triangle counts only if amalgam's
+/// own test of that triangle, with amalgam's world-space ray, accepts it too. Embree takes the
+/// ray into an instance's object space with its own float inverse of the transform, off by the
+/// rounding of the ray origin's distance from the world origin (1e-5 m at 100 m), more than the
+/// shadow ray's offset from its surface: it then meets the triangle it leaves again, behind its
+/// origin (docs/embree.md). amalgam's test, with its nearly exact transform, rejects such a hit
+/// (one that may lie behind the origin within its rounding bound). Otherwise the filter only
+/// drops a hit amalgam's test places just outside the triangle (a ray through an edge).
+template <class H>
+void triangle_occlusion_filter(const RTCFilterFunctionNArguments* a) {
+  const auto& g = *static_cast<const UserGeometry*>(a->geometryUserPtr);
+  const auto* q = reinterpret_cast<const QueryContext*>(a->context);
+  for (unsigned i = 0; i < a->N; ++i) {
+    if (a->valid[i] == 0) continue;
+    std::uint64_t id = g.ids[RTCHitN_primID(a->hit, a->N, i)];
+    if constexpr (kInstanced<H>) {
+      id = InstancedHierarchy::id(a->context->instID[0] + 1ull, static_cast<std::uint32_t>(id));
+    }
+    if (!static_cast<const H*>(g.hierarchy)->intersect(id, *q->ray)) a->valid[i] = 0;
   }
 }
 
@@ -178,13 +203,18 @@ struct EmbreeScene::Impl {
       check("triangle buffers");
       std::copy(v.begin(), v.end(), vb);
       for (std::size_t i = 0; i < 3 * tris; ++i) ib[i] = static_cast<std::uint32_t>(i);
+      m.triangles = std::make_unique<UserGeometry>();
+      m.triangles->hierarchy = &h;
+      m.triangles->ids = m.ids[kTriangles].data();
+      rtcSetGeometryUserData(g, m.triangles.get());
+      rtcSetGeometryOccludedFilterFunction(g, triangle_occlusion_filter<H>);
       rtcCommitGeometry(g);
       rtcAttachGeometryByID(m.scene, g, kTriangles);
       rtcReleaseGeometry(g);
     }
     if (!m.ids[kUser].empty()) {
       m.user->hierarchy = &h;
-      m.user->ids = &m.ids[kUser];
+      m.user->ids = m.ids[kUser].data();
       RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
       rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(m.ids[kUser].size()));
       rtcSetGeometryUserData(g, m.user.get());

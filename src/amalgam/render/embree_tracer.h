@@ -8,8 +8,10 @@
 /// user geometry whose callbacks call the hierarchy's own intersect() (the same surfaces, bit
 /// for bit); an instanced scene as one Embree scene per mesh and one Embree instance per
 /// instance with the same 3x4 transform; an implicit builtin's primitives listed once. Closest
-/// hits by rtcIntersect1, shadow rays by rtcOccluded1. A hit's surface (point, normal, error
-/// bound for the shadow-ray origin) is recomputed by the hierarchy's own test of the one
+/// hits by rtcIntersect1, shadow rays by rtcOccluded1, where a triangle's occlusion filter
+/// keeps only hits amalgam's own test of it accepts (Embree's transform into an instance can
+/// put a shadow ray behind the triangle it leaves; docs/embree.md). A hit's surface (point, normal,
+/// error bound for the shadow-ray origin) is recomputed by the hierarchy's own test of the one
 /// primitive Embree found, so shading matches the traditional renderer wherever both hit the
 /// same primitive. Embree counts no intersection tests: the counters hold rays only.
 
