@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Quality vs cost of amalgams on a real-mesh field.
 #
-#   scripts/quality-vs-cost.sh           full study (about 3-6 minutes on 2 cores): writes
+#   scripts/quality-vs-cost.sh           full study (about 25 s on 2 cores): writes
 #                                        docs/quality-vs-cost/{results.csv, *.png} and the
 #                                        generated part of docs/quality-vs-cost.md
 #   scripts/quality-vs-cost.sh --quick   smoke run (tiny images) into a temporary directory;
