@@ -19,6 +19,7 @@
 #include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
 #include "amalgam/io/srgb.h"
+#include "cli_support.h"
 
 namespace {
 
@@ -31,28 +32,14 @@ struct CliRun {
 
 // Runs the binary with `args` (a shell-quoted string); stdout captured, stderr to err_file.
 CliRun run(const std::string& args, const std::string& err_file = "/dev/null") {
-  const std::string cmd = std::string(AMALGAM_BINARY) + " " + args + " 2>" + err_file;
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+  const auto r =
+      amalgam::test::run_command(std::string(AMALGAM_BINARY) + " " + args + " 2>" + err_file);
+  return {r.status, r.out};
 }
 
 /// This process's scratch directory, removed when the process ends.
 fs::path temp_dir() {
-  struct Scratch {
-    fs::path dir = fs::temp_directory_path() / ("amalgam-cli-" + std::to_string(getpid()));
-    ~Scratch() {
-      std::error_code ec;
-      fs::remove_all(dir, ec);
-    }
-  };
-  static const Scratch scratch;
-  fs::create_directories(scratch.dir);
-  return scratch.dir;
+  return amalgam::test::scratch_dir("amalgam-cli");
 }
 
 TEST(Cli, TraceLineTraditionalIsTheWorstCase) {
@@ -295,10 +282,7 @@ std::vector<std::string> entries(const fs::path& d) {
   return names;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using amalgam::test::slurp;
 
 /// The lines of `err_file`.
 std::vector<std::string> lines_of(const fs::path& err_file) {

@@ -19,6 +19,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "cli_support.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -29,18 +31,10 @@ struct CliResult {
 };
 
 CliResult run(const std::string& args) {
-  const fs::path err = fs::temp_directory_path() / ("amalgam-embree-" + std::to_string(getpid()));
-  const std::string cmd = std::string(AMALGAM_BINARY) + " " + args + " 2>" + err.string();
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int st = pclose(p);
-  std::ifstream in(err);
-  std::string e{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  fs::remove(err);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out, e};
+  const fs::path err = amalgam::test::scratch_dir("amalgam-embree-cli") / "stderr.txt";
+  const auto r =
+      amalgam::test::run_command(std::string(AMALGAM_BINARY) + " " + args + " 2>" + err.string());
+  return {r.status, r.out, amalgam::test::slurp(err)};
 }
 
 const std::string kOut = (fs::temp_directory_path() / "amalgam-embree-cli.pfm").string();

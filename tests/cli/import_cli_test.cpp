@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "amalgam/io/image.h"
+#include "cli_support.h"
 
 namespace {
 
@@ -28,28 +29,16 @@ struct CliResult {
 };
 
 fs::path scratch() {
-  struct Dir {
-    fs::path dir = fs::temp_directory_path() / ("amalgam-import-cli-" + std::to_string(getpid()));
-    ~Dir() {
-      std::error_code ec;
-      fs::remove_all(dir, ec);
-    }
-  };
-  static const Dir d;
-  fs::create_directories(d.dir);
-  return d.dir;
+  return amalgam::test::scratch_dir("amalgam-import-cli");
 }
 
 /// Runs the binary with `args` (shell-quoted); stdout discarded, stderr returned.
 CliResult run(const std::string& args) {
   const fs::path err = scratch() / "stderr.txt";
-  const std::string cmd =
-      std::string(AMALGAM_BINARY) + " " + args + " >/dev/null 2>" + err.string();
-  const int st = std::system(cmd.c_str());
-  std::ifstream in(err);
-  std::stringstream text;
-  text << in.rdbuf();
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, text.str()};
+  const int status = amalgam::test::run_command(std::string(AMALGAM_BINARY) + " " + args +
+                                                " >/dev/null 2>" + err.string())
+                         .status;
+  return {status, amalgam::test::slurp(err)};
 }
 
 std::vector<std::string> lines(const std::string& text) {

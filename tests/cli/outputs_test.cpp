@@ -30,43 +30,21 @@
 
 #include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
+#include "cli_support.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int status;
-  std::string out;
-};
+using amalgam::test::slurp;
+using Result = amalgam::test::CommandResult;
 
 Result amalgam(const std::string& args, const std::string& err_file = "/dev/null") {
-  const std::string cmd = std::string(AMALGAM_BINARY) + " " + args + " 2>" + err_file;
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+  return amalgam::test::run_command(std::string(AMALGAM_BINARY) + " " + args + " 2>" + err_file);
 }
 
 fs::path temp_dir() {
-  struct Scratch {
-    fs::path dir = fs::temp_directory_path() / ("amalgam-outputs-" + std::to_string(getpid()));
-    ~Scratch() {
-      std::error_code ec;
-      fs::remove_all(dir, ec);
-    }
-  };
-  static const Scratch scratch;
-  fs::create_directories(scratch.dir);
-  return scratch.dir;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  return amalgam::test::scratch_dir("amalgam-outputs");
 }
 
 /// Every channel of an EXR file as float, by name; checks each is stored as FLOAT.
