@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Benchmarks: builds Release and runs the kernel benchmarks, amalgam vs Embree side by side.
 #
-#   scripts/bench.sh            full run (about 30 minutes on 2 cores): bench/results/ (Google
+#   scripts/bench.sh            full run (about 3 minutes on 2 cores): bench/results/ (Google
 #                               Benchmark JSON, the field's results.json and images), the tables
 #                               in docs/benchmarks.md and the README's speed section (between
 #                               its bench markers), every ratio from this one run
