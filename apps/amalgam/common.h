@@ -33,7 +33,7 @@ struct CommonOptions {
   std::string camera, eye, look_at, up, fov;  ///< the view options, as given
   CameraChoice view;                          ///< set by finish()
 
-  /// Registers SCENE, --set and the renderer options of CONTRACT.md on `app`.
+  /// Registers SCENE, --set and the renderer options of docs/cli.md on `app`.
   void add_to(CLI::App& app);
   /// Converts the parsed text into `options`; throws InputError on bad values, and on options
   /// --tracer embree cannot honour (it renders at full detail) or a build without Embree.

@@ -1,4 +1,4 @@
-/// The `amalgam` command line: render, trace, scenes, experiment, compare (see CONTRACT.md).
+/// The `amalgam` command line: render, trace, scenes, experiment, compare (see docs/cli.md).
 
 #include <CLI/CLI.hpp>
 #include <cstdio>

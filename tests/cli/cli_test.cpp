@@ -1,4 +1,4 @@
-// End-to-end tests of the `amalgam` binary: the outside contract of CONTRACT.md.
+// End-to-end tests of the `amalgam` binary: the outside contract (docs/cli.md, docs/outputs.md).
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>

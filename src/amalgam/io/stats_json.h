@@ -1,5 +1,5 @@
 #pragma once
-/// \file The stats JSON of CONTRACT.md ("renderer", "scene", "rays", "tests", ...), with the
+/// \file The stats JSON of docs/outputs.md ("renderer", "scene", "rays", "tests", ...), with the
 /// run's description (docs/outputs.md lists every key and its unit).
 
 #include <cstdint>

@@ -1,5 +1,5 @@
 #pragma once
-/// \file Renderer options shared by `render`, `trace` and `experiment` (CONTRACT.md).
+/// \file Renderer options shared by `render`, `trace` and `experiment` (docs/cli.md).
 
 #include <cstdint>
 #include <optional>
