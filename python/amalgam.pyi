@@ -1,0 +1,81 @@
+"""Type stub of the amalgam module (python/amalgam_module.cpp; docs/python.md)."""
+
+from typing import Any, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class RenderResult:
+    """The outputs of Scene.render. Pixel (x, y) is [y, x], row 0 at the top."""
+
+    image: npt.NDArray[np.float32]  # H x W x 3, linear RGB (the CLI's PFM image)
+    cost: npt.NDArray[np.float64]  # H x W, exact intersection tests per pixel / spp
+    tests: npt.NDArray[np.uint64]  # H x W, exact tests per pixel, total over its samples
+    depth: npt.NDArray[np.float32]  # H x W, mean primary-hit distance (inf: none)
+    level: npt.NDArray[np.float32]  # H x W, rendered level (-2 primitives, -1 nothing)
+    normal: npt.NDArray[np.float32]  # H x W x 3
+    albedo: npt.NDArray[np.float32]  # H x W x 3
+    stats: dict[str, Any]  # the CLI's stats JSON
+    width: int
+    height: int
+    spp: int  # samples per pixel the image holds
+    spp_requested: int
+    interrupted: bool
+    seconds: float
+
+class Scene:
+    """A loaded scene: its built, baked hierarchy, reused by every render."""
+
+    @property
+    def last_result(self) -> Optional[RenderResult]: ...
+    @property
+    def levels(self) -> int: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def warnings(self) -> list[str]: ...
+    def render(
+        self,
+        *,
+        width: int = 512,
+        height: int = 512,
+        spp: int = 4,
+        renderer: str = "scale-sensitive",  # or "traditional"
+        opacity: str = "stochastic",  # or "deterministic"
+        level: Optional[int] = None,
+        footprint: Optional[float] = None,
+        order: str = "sorted",  # or "unsorted"
+        seed: int = 0,
+        threads: int = 0,  # 0: all cores
+    ) -> RenderResult:
+        """Renders the camera view; KeyboardInterrupt carries `.partial` (a RenderResult)."""
+    def trace(
+        self,
+        origin: Optional[Sequence[float]] = None,
+        direction: Optional[Sequence[float]] = None,
+        *,
+        width: int = 512,
+        height: int = 512,
+        renderer: str = "scale-sensitive",
+        opacity: str = "stochastic",
+        level: Optional[int] = None,
+        footprint: Optional[float] = None,
+        order: str = "sorted",
+        seed: int = 0,
+    ) -> dict[str, Any]:
+        """One primary ray with its shadow rays: 'hit', 'colour' and the counts."""
+
+def load(scene: str, **params: Union[int, float, str]) -> Scene:
+    """'builtin:NAME' with parameters as keywords, a scene .json, or a mesh path."""
+
+def compare(
+    a: Union[RenderResult, npt.ArrayLike], b: Union[RenderResult, npt.ArrayLike]
+) -> dict[str, float]:
+    """width, height, rmse, psnr, ssim, mean_abs, max_abs, rel_mse (b the reference)."""
+
+def experiment(name: str, quick: bool = True, threads: int = 0) -> list[dict[str, float]]:
+    """One of the paper's analyses; its table as a list of rows."""
+
+def experiment_names() -> list[str]: ...

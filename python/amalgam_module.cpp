@@ -1,0 +1,446 @@
+/// \file The Python module `amalgam` (docs/python.md): the library's scene loader, renderer,
+/// experiments and image metrics, with images as NumPy arrays. Wraps the library, not the CLI;
+/// the option names and error messages follow the CLI's (docs/cli.md).
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "amalgam/analysis/experiments.h"
+#include "amalgam/analysis/metrics.h"
+#include "amalgam/io/colormap.h"
+#include "amalgam/io/stats_json.h"
+#include "amalgam/load/load_scene.h"
+#include "amalgam/render/render.h"
+#include "amalgam/util/error.h"
+#include "amalgam/util/version.h"
+
+namespace py = pybind11;
+using namespace amalgam;
+
+namespace {
+
+static_assert(sizeof(Vec3) == 3 * sizeof(float), "images are viewed as float32 H x W x 3");
+
+/// A NumPy array viewing `v`'s data without a copy: the vector moves onto the heap and the
+/// array's base (a capsule) frees it with the last reference.
+template <typename Elem, typename T>
+py::array view(std::vector<T>&& v, std::vector<py::ssize_t> shape) {
+  auto* owner = new std::vector<T>(std::move(v));
+  py::capsule base(owner, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  std::vector<py::ssize_t> strides(shape.size());
+  py::ssize_t s = sizeof(Elem);
+  for (std::size_t i = shape.size(); i-- > 0;) {
+    strides[i] = s;
+    s *= shape[i];
+  }
+  return py::array(py::dtype::of<Elem>(), shape, strides,
+                   reinterpret_cast<const Elem*>(owner->data()), base);
+}
+
+/// nlohmann::json -> Python objects (through the json module: the same numbers and nulls).
+py::object to_python(const nlohmann::json& j) {
+  return py::module_::import("json").attr("loads")(j.dump());
+}
+
+/// Render options and view, checked.
+struct Options {
+  RenderOptions o;
+  CameraChoice view;
+};
+
+Options make_options(int width, int height, int spp, const std::string& renderer,
+                     const std::string& opacity, std::optional<int> level,
+                     std::optional<float> footprint, const std::string& order, std::uint64_t seed,
+                     int threads) {
+  // The checks and messages of the CLI (apps/amalgam/common.cpp, CommonOptions::finish).
+  if (renderer != "scale-sensitive" && renderer != "traditional")
+    throw InputError("--renderer " + one_line(renderer, 40) +
+                     ": expected scale-sensitive or traditional");
+  if (opacity != "stochastic" && opacity != "deterministic")
+    throw InputError("--opacity " + one_line(opacity, 40) +
+                     ": expected stochastic or deterministic");
+  if (order != "sorted" && order != "unsorted")
+    throw InputError("--order " + one_line(order, 40) + ": expected sorted or unsorted");
+  if (level && footprint)
+    throw InputError("--level and --footprint: give one (a fixed level, or render by footprint)");
+  if (renderer == "traditional" && (level || footprint))
+    throw InputError(std::string("--renderer traditional renders no amalgam: ") +
+                     (level ? "--level" : "--footprint") + " does not apply");
+  if (level && *level < 0)
+    throw InputError("--level " + std::to_string(*level) + ": expected an integer >= 0");
+  if (footprint && !(*footprint > 0.0f && *footprint < 1e30f))
+    throw InputError("--footprint: expected a number > 0");
+  if (width < 1)
+    throw InputError("--width " + std::to_string(width) + ": expected an integer >= 1");
+  if (height < 1)
+    throw InputError("--height " + std::to_string(height) + ": expected an integer >= 1");
+  if (spp < 1) throw InputError("--spp " + std::to_string(spp) + ": expected an integer >= 1");
+  if (threads < 0)
+    throw InputError("--threads " + std::to_string(threads) + ": expected an integer >= 0");
+  Options r;
+  r.o.renderer =
+      renderer == "traditional" ? RendererKind::kTraditional : RendererKind::kScaleSensitive;
+  r.o.opacity = opacity == "deterministic" ? OpacityKind::kDeterministic : OpacityKind::kStochastic;
+  r.o.level = level;
+  r.o.footprint = footprint ? *footprint : 1.0f;
+  r.o.sorted = order == "sorted";
+  r.o.seed = seed;
+  r.o.threads = threads;
+  r.o.width = width;
+  r.o.height = height;
+  r.o.spp = spp;
+  return r;
+}
+
+/// What `Scene.render` returns: the image and the other outputs as NumPy arrays, and the stats.
+struct RenderResult {
+  int width = 0, height = 0, spp = 0, spp_requested = 0;
+  bool interrupted = false;
+  double seconds = 0;
+  py::array image, cost, tests, depth, level, normal, albedo;
+  py::object stats;
+};
+
+/// Converts a finished (or interrupted) render; needs the GIL.
+std::shared_ptr<RenderResult> make_result(const LoadedScene& scene, const RenderOptions& o,
+                                          RenderOutput&& r) {
+  auto res = std::make_shared<RenderResult>();
+  const bool whole = r.image.size() == static_cast<std::size_t>(r.width) * r.height && r.spp > 0;
+  const py::ssize_t h = whole ? r.height : 0, w = whole ? r.width : 0;
+  nlohmann::json j = stats_json(scene, o, r.counters, r.per_primary, r.seconds);
+  RunInfo run;
+  run.argv = {"amalgam.Scene.render"};
+  run.width = r.width;
+  run.height = r.height;
+  run.spp = r.spp;
+  run.threads = render_threads(o);
+  run.cost_range = own_range(r.cost);
+  add_run_info(j, run);
+  res->stats = to_python(j);
+  res->width = r.width;
+  res->height = r.height;
+  res->spp = r.spp;
+  res->spp_requested = o.spp;
+  res->interrupted = r.interrupted;
+  res->seconds = r.seconds;
+  auto plane = [&](auto&& v, auto elem) {
+    using E = decltype(elem);
+    if (!whole || v.size() != static_cast<std::size_t>(h * w)) return view<E>(std::move(v), {0, 0});
+    return view<E>(std::move(v), {h, w});
+  };
+  auto rgb = [&](std::vector<Vec3>&& v) {
+    if (!whole || v.size() != static_cast<std::size_t>(h * w))
+      return view<float>(std::vector<Vec3>{}, {0, 0, 3});
+    return view<float>(std::move(v), {h, w, 3});
+  };
+  res->image = rgb(std::move(r.image));
+  res->normal = rgb(std::move(r.normal));
+  res->albedo = rgb(std::move(r.albedo));
+  res->cost = plane(std::move(r.cost), double{});
+  res->tests = plane(std::move(r.tests), std::uint64_t{});
+  res->depth = plane(std::move(r.depth), float{});
+  res->level = plane(std::move(r.level), float{});
+  return res;
+}
+
+/// A loaded scene: the built, baked hierarchy, shared by every render of it.
+struct Scene {
+  std::shared_ptr<const LoadedScene> scene;
+  std::string spec;
+  std::shared_ptr<RenderResult> last_result;
+  std::mutex last_mutex;
+
+  std::shared_ptr<RenderResult> render(int width, int height, int spp, const std::string& renderer,
+                                       const std::string& opacity, std::optional<int> level,
+                                       std::optional<float> footprint, const std::string& order,
+                                       std::uint64_t seed, int threads) {
+    const Options opt =
+        make_options(width, height, spp, renderer, opacity, level, footprint, order, seed, threads);
+    check_options(*scene, opt.o);
+    // The render runs on its own thread while this one, without the GIL, waits for it and
+    // every 50 ms takes the GIL to run Python's signal handlers (PyErr_CheckSignals): a
+    // KeyboardInterrupt cancels the render at its next tile (RenderControl::cancel).
+    auto cancel = std::make_shared<std::atomic<bool>>(false);
+    std::shared_ptr<const LoadedScene> keep = scene;
+    const RenderOptions o = opt.o;
+    std::packaged_task<RenderOutput()> task([keep, o, cancel] {
+      RenderControl control;
+      control.cancel = cancel.get();
+      return amalgam::render(*keep, o, nullptr, control);
+    });
+    std::future<RenderOutput> done = task.get_future();
+    std::optional<py::error_already_set> interrupt;
+    {
+      py::gil_scoped_release nogil;
+      std::thread worker(std::move(task));
+      while (done.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+        if (interrupt) continue;
+        py::gil_scoped_acquire gil;
+        if (PyErr_CheckSignals() != 0) {
+          interrupt.emplace();  // fetches the exception the handler raised
+          cancel->store(true);
+        }
+      }
+      worker.join();
+    }
+    RenderOutput out = done.get();  // rethrows a failure of the render
+    auto result = make_result(*scene, o, std::move(out));
+    {
+      std::lock_guard<std::mutex> lock(last_mutex);
+      last_result = result;
+    }
+    if (interrupt) {
+      // The partial result (the completed passes) travels with the exception.
+      if (interrupt->value()) py::setattr(interrupt->value(), "partial", py::cast(result));
+      throw *interrupt;
+    }
+    return result;
+  }
+
+  py::dict trace(std::optional<std::vector<float>> origin,
+                 std::optional<std::vector<float>> direction, int width, int height,
+                 const std::string& renderer, const std::string& opacity, std::optional<int> level,
+                 std::optional<float> footprint, const std::string& order, std::uint64_t seed) {
+    const Options opt =
+        make_options(width, height, 1, renderer, opacity, level, footprint, order, seed, 1);
+    check_options(*scene, opt.o);
+    Ray ray = scene->env.camera.centre_ray(width, height);
+    auto vec = [](const std::vector<float>& v, const char* what) {
+      if (v.size() != 3) throw InputError(std::string(what) + ": expected three numbers x,y,z");
+      const Vec3 r{v[0], v[1], v[2]};
+      if (!is_finite(r)) throw InputError(std::string(what) + ": expected three numbers x,y,z");
+      return r;
+    };
+    if (origin || direction) {
+      const Vec3 o = origin ? vec(*origin, "--origin") : ray.origin;
+      const Vec3 d = direction ? vec(*direction, "--direction") : ray.dir;
+      if (length(d) == 0.0f) throw InputError("--direction: must not be the zero vector");
+      const float spread = ray.cone_spread;
+      ray = Ray::make(o, normalize(d));
+      ray.cone_spread = spread;
+    }
+    TraceOutput t;
+    double secs = 0;
+    {
+      py::gil_scoped_release nogil;
+      const auto t0 = std::chrono::steady_clock::now();
+      t = amalgam::trace(*scene, opt.o, ray);
+      secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    nlohmann::json j = stats_json(*scene, opt.o, t.counters, t.per_primary, secs);
+    if (t.hit.kind == TraceHit::Kind::kNone) {
+      j["hit"] = nullptr;
+    } else {
+      j["hit"] = {{"t", t.hit.t},
+                  {"object",
+                   {{"kind", t.hit.kind == TraceHit::Kind::kPrimitive ? "primitive" : "amalgam"},
+                    {"id", t.hit.id},
+                    {"level", t.hit.level}}},
+                  {"point", {t.hit.surf.p.x, t.hit.surf.p.y, t.hit.surf.p.z}}};
+    }
+    j["colour"] = {t.colour.x, t.colour.y, t.colour.z};
+    return to_python(j);
+  }
+};
+
+std::shared_ptr<Scene> load(const std::string& spec, const py::kwargs& params) {
+  Params p(spec);
+  for (auto item : params)
+    p.set(py::str(item.first).cast<std::string>(), py::str(item.second).cast<std::string>());
+  auto s = std::make_shared<Scene>();
+  s->spec = spec;
+  {
+    py::gil_scoped_release nogil;
+    s->scene = std::make_shared<const LoadedScene>(load_scene(spec, p));
+  }
+  return s;
+}
+
+/// An image argument of `compare`: a RenderResult or an H x W x 3 array.
+std::vector<Vec3> pixels(const py::object& x, const char* name, int& w, int& h) {
+  py::object a = x;
+  if (py::isinstance<RenderResult>(x)) a = x.cast<RenderResult&>().image;
+  auto arr = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(a);
+  if (!arr || arr.ndim() != 3 || arr.shape(2) != 3)
+    throw InputError(std::string(name) + ": expected an H x W x 3 image (array or RenderResult)");
+  h = static_cast<int>(arr.shape(0));
+  w = static_cast<int>(arr.shape(1));
+  std::vector<Vec3> v(static_cast<std::size_t>(w) * h);
+  const float* d = arr.data();
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = {d[3 * i], d[3 * i + 1], d[3 * i + 2]};
+  return v;
+}
+
+py::dict compare(const py::object& a, const py::object& b) {
+  int wa = 0, ha = 0, wb = 0, hb = 0;
+  const std::vector<Vec3> pa = pixels(a, "a", wa, ha), pb = pixels(b, "b", wb, hb);
+  if (wa != wb || ha != hb)
+    throw InputError("a is " + std::to_string(wa) + "x" + std::to_string(ha) + " but b is " +
+                     std::to_string(wb) + "x" + std::to_string(hb) +
+                     ": compare needs images of the same size");
+  if (wa == 0 || ha == 0) throw InputError("a: the image is empty");
+  ImageComparison c;
+  {
+    py::gil_scoped_release nogil;
+    c = compare_images(pa, pb, wa, ha);
+  }
+  py::dict d;
+  d["width"] = wa;
+  d["height"] = ha;
+  d["rmse"] = c.rmse;
+  d["psnr"] = c.psnr;
+  d["ssim"] = c.ssim;
+  d["mean_abs"] = c.mean_abs;
+  d["max_abs"] = c.max_abs;
+  d["rel_mse"] = c.rel_mse;
+  return d;
+}
+
+py::list experiment(const std::string& name, bool quick, int threads) {
+  const auto& names = experiments::names();
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    std::string all;
+    for (const auto& n : names) all += (all.empty() ? "" : ", ") + n;
+    throw InputError("experiment " + one_line(name, 40) + ": unknown (one of: " + all + ")");
+  }
+  if (threads < 0)
+    throw InputError("--threads " + std::to_string(threads) + ": expected an integer >= 0");
+  experiments::ExperimentResult r;
+  {
+    py::gil_scoped_release nogil;
+    r = experiments::run(name, experiments::Config{quick, threads});
+  }
+  py::list rows;
+  for (const auto& row : r.table.rows) {
+    py::dict d;
+    for (std::size_t i = 0; i < r.table.columns.size() && i < row.size(); ++i)
+      d[py::str(r.table.columns[i])] = row[i];
+    rows.append(d);
+  }
+  return rows;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(amalgam, m) {
+  m.doc() =
+      "amalgam: a ray tracer after Thompson & Fussell 1991, 'Time Costs of Ray Tracing with\n"
+      "Amalgams', with exact cost statistics.\n\n"
+      "  scene = amalgam.load('builtin:tube', n=64)       # built and baked once\n"
+      "  r = scene.render(width=256, height=256, spp=4)   # r.image: float32 H x W x 3\n"
+      "  r.cost, r.stats                                  # tests per pixel, stats dict\n"
+      "  amalgam.compare(r, reference)                    # rmse, psnr, ssim, ...\n"
+      "  amalgam.experiment('expected', quick=True)       # the table as a list of dicts\n\n"
+      "Bad input raises ValueError, runtime failures RuntimeError, each with the CLI's\n"
+      "one-line message. See docs/python.md.";
+  m.attr("__version__") = version();
+
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const MetricsError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const RuntimeError& e) {
+      PyErr_SetString(PyExc_RuntimeError, e.what());
+    } catch (const InternalError& e) {
+      PyErr_SetString(PyExc_RuntimeError, e.what());
+    }
+  });
+
+  py::class_<RenderResult, std::shared_ptr<RenderResult>>(
+      m, "RenderResult",
+      "The outputs of Scene.render (docs/outputs.md). Pixel (x, y) is [y, x], row 0 at the top.")
+      .def_readonly("image", &RenderResult::image,
+                    "float32 H x W x 3: linear RGB, mean over the samples (the CLI's PFM image)")
+      .def_readonly("cost", &RenderResult::cost,
+                    "float64 H x W: exact intersection tests per pixel (all rays) / spp")
+      .def_readonly("tests", &RenderResult::tests,
+                    "uint64 H x W: exact intersection tests per pixel, total over its samples")
+      .def_readonly("depth", &RenderResult::depth,
+                    "float32 H x W: mean distance of the primary hits (inf: none)")
+      .def_readonly("level", &RenderResult::level,
+                    "float32 H x W: level of the rendered amalgams (-2: primitives, -1: nothing)")
+      .def_readonly("normal", &RenderResult::normal, "float32 H x W x 3: mean shading normal")
+      .def_readonly("albedo", &RenderResult::albedo, "float32 H x W x 3: mean diffuse colour")
+      .def_readonly("stats", &RenderResult::stats,
+                    "dict: the CLI's stats JSON (--stats) for this render")
+      .def_readonly("width", &RenderResult::width)
+      .def_readonly("height", &RenderResult::height)
+      .def_readonly("spp", &RenderResult::spp, "samples per pixel the image holds")
+      .def_readonly("spp_requested", &RenderResult::spp_requested)
+      .def_readonly("interrupted", &RenderResult::interrupted,
+                    "True when a KeyboardInterrupt stopped the render before spp_requested")
+      .def_readonly("seconds", &RenderResult::seconds, "render time")
+      .def("__repr__", [](const RenderResult& r) {
+        return "<amalgam.RenderResult " + std::to_string(r.width) + "x" + std::to_string(r.height) +
+               ", " + std::to_string(r.spp) + " spp" + (r.interrupted ? ", interrupted" : "") + ">";
+      });
+
+  py::class_<Scene, std::shared_ptr<Scene>>(
+      m, "Scene", "A loaded scene (amalgam.load): its built, baked hierarchy, reused by renders.")
+      .def("render", &Scene::render, py::kw_only(), py::arg("width") = 512, py::arg("height") = 512,
+           py::arg("spp") = 4, py::arg("renderer") = "scale-sensitive",
+           py::arg("opacity") = "stochastic", py::arg("level") = py::none(),
+           py::arg("footprint") = py::none(), py::arg("order") = "sorted", py::arg("seed") = 0,
+           py::arg("threads") = 0,
+           "Renders the scene's camera view; the options are the CLI's (docs/cli.md). The same\n"
+           "seed gives the same image as `amalgam render ... --out x.pfm`, bit for bit, on any\n"
+           "number of threads. The GIL is released. Ctrl-C (KeyboardInterrupt) stops the render\n"
+           "at its next tile; the exception's `partial` attribute (and scene.last_result) holds\n"
+           "the completed samples. Raises ValueError on bad options (e.g. level beyond l_max).")
+      .def("trace", &Scene::trace, py::arg("origin") = py::none(),
+           py::arg("direction") = py::none(), py::kw_only(), py::arg("width") = 512,
+           py::arg("height") = 512, py::arg("renderer") = "scale-sensitive",
+           py::arg("opacity") = "stochastic", py::arg("level") = py::none(),
+           py::arg("footprint") = py::none(), py::arg("order") = "sorted", py::arg("seed") = 0,
+           "Traces one primary ray with its shadow rays (`amalgam trace`): by default the\n"
+           "camera's centre ray. Returns the CLI's trace JSON as a dict: 'hit' (None or t,\n"
+           "object {kind, id, level}, point), 'colour', 'rays', 'tests', ...")
+      .def_property_readonly(
+          "last_result",
+          [](Scene& s) {
+            std::lock_guard<std::mutex> lock(s.last_mutex);
+            return s.last_result;
+          },
+          "The result of the latest render that returned or was interrupted (None before)")
+      .def_property_readonly(
+          "levels", [](const Scene& s) { return s.scene->info().levels; },
+          "levels of the hierarchy (a level option is < levels)")
+      .def_property_readonly("name", [](const Scene& s) { return s.scene->name; })
+      .def_property_readonly(
+          "warnings", [](const Scene& s) { return s.scene->warnings; },
+          "what the scene file holds that is not rendered")
+      .def("__repr__", [](const Scene& s) { return "<amalgam.Scene " + s.spec + ">"; });
+
+  m.def("load", &load, py::arg("scene"),
+        "load(scene, **params) -> Scene\n\n"
+        "Loads, builds and bakes a scene: 'builtin:NAME' with its parameters as keyword\n"
+        "arguments (the CLI's --set key=value, e.g. load('builtin:tube', n=64)), a scene .json,\n"
+        "or a mesh path. Raises ValueError with the CLI's message on bad input.");
+  m.def("compare", &compare, py::arg("a"), py::arg("b"),
+        "compare(a, b) -> dict\n\n"
+        "Image metrics of `amalgam compare` for two H x W x 3 images (arrays or RenderResults),\n"
+        "b the reference: width, height, rmse, psnr, ssim, mean_abs, max_abs, rel_mse.");
+  m.def("experiment", &experiment, py::arg("name"), py::arg("quick") = true, py::arg("threads") = 0,
+        "experiment(name, quick=True, threads=0) -> list[dict]\n\n"
+        "Runs one of the paper's analyses (`amalgam experiment NAME`) and returns its table\n"
+        "(the CSV's rows) as a list of dicts keyed by column. The GIL is released.");
+  m.def(
+      "experiment_names", [] { return experiments::names(); },
+      "The experiment names in report order.");
+}
