@@ -1,0 +1,90 @@
+"""Errors: ValueError for bad input with the CLI's one-line message; KeyboardInterrupt."""
+
+import os
+import signal
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import amalgam
+
+
+def cli_message(cli, *args):
+    """The CLI's one-line error message (after "amalgam: ") and its exit status."""
+    p = subprocess.run([cli, *args], capture_output=True, text=True)
+    return p.stderr.strip().removeprefix("amalgam: "), p.returncode
+
+
+def test_unknown_builtin_is_value_error(cli, tmp_path):
+    message, status = cli_message(cli, "render", "builtin:nope", "--out", str(tmp_path / "x.pfm"))
+    assert status == 2
+    with pytest.raises(ValueError) as e:
+        amalgam.load("builtin:nope")
+    assert str(e.value) == message
+
+
+def test_unknown_parameter_is_value_error(cli, tmp_path):
+    message, _ = cli_message(cli, "render", "builtin:demo", "--set", "bogus=1", "--out",
+                             str(tmp_path / "x.pfm"))
+    with pytest.raises(ValueError) as e:
+        amalgam.load("builtin:demo", bogus=1)
+    assert str(e.value) == message
+
+
+def test_level_beyond_lmax_is_value_error(cli, demo, tmp_path):
+    message, status = cli_message(cli, "render", "builtin:demo", "--level", "99", "--out",
+                                  str(tmp_path / "x.pfm"))
+    assert status == 2
+    with pytest.raises(ValueError) as e:
+        demo.render(width=8, height=8, spp=1, level=99)
+    assert str(e.value) == message
+
+
+def test_bad_options_are_value_errors(demo, tmp_path):
+    with pytest.raises(ValueError, match="give one"):
+        demo.render(width=8, height=8, level=1, footprint=2.0)
+    with pytest.raises(ValueError, match="--renderer"):
+        demo.render(width=8, height=8, renderer="fast")
+    with pytest.raises(ValueError, match="--spp"):
+        demo.render(width=8, height=8, spp=0)
+    with pytest.raises(ValueError, match="--direction"):
+        demo.trace(direction=[0, 0, 0])
+    with pytest.raises(ValueError, match="same size"):
+        amalgam.compare(np.zeros((2, 2, 3)), np.zeros((3, 2, 3)))
+    with pytest.raises(ValueError, match="unknown"):
+        amalgam.experiment("nope")
+    missing = tmp_path / "missing.json"
+    with pytest.raises(ValueError, match="missing.json"):
+        amalgam.load(str(missing))
+
+
+def test_keyboard_interrupt_stops_render(demo):
+    # A render of minutes, interrupted by SIGINT after half a second.
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt) as e:
+            demo.render(width=256, height=256, spp=5000, seed=1)
+    finally:
+        timer.cancel()
+    partial = e.value.partial
+    assert partial is demo.last_result
+    # Stopped early: 5000 samples would take minutes.
+    assert partial.interrupted and partial.spp < partial.spp_requested == 5000
+    if partial.spp > 0:
+        assert partial.image.shape == (256, 256, 3)
+        assert int(partial.tests.sum()) == partial.stats["tests"]["total"]
+        # The completed samples are exactly those of an uninterrupted render of that many.
+        again = demo.render(width=256, height=256, spp=partial.spp, seed=1)
+        assert np.array_equal(again.image, partial.image)
+    # The scene still renders afterwards.
+    assert demo.render(width=8, height=8, spp=1).spp == 1
+
+
+def test_help_shows_the_api():
+    doc = amalgam.__doc__
+    assert "load" in doc and "render" in doc
+    assert "KeyboardInterrupt" in amalgam.Scene.render.__doc__
+    assert amalgam.load.__doc__.startswith("load(")

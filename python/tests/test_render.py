@@ -1,0 +1,140 @@
+"""Scene.render: bit-identity with the CLI's PFM, shapes, dtypes, stats, reuse, threads."""
+
+import json
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import amalgam
+
+
+def read_pfm(path):
+    """A colour PFM ("PF", rows bottom to top) as an H x W x 3 float32 array, top row first."""
+    with open(path, "rb") as f:
+        data = f.read()
+    parts = data.split(b"\n", 3)
+    assert parts[0] == b"PF"
+    width, height = (int(v) for v in parts[1].split())
+    scale = float(parts[2])
+    dtype = "<f4" if scale < 0 else ">f4"
+    pixels = np.frombuffer(parts[3], dtype=dtype, count=width * height * 3)
+    return pixels.reshape(height, width, 3)[::-1].astype(np.float32)
+
+
+@pytest.mark.parametrize(
+    "args, kwargs",
+    [
+        ([], {}),
+        (["--renderer", "traditional"], {"renderer": "traditional"}),
+        (["--level", "4", "--opacity", "deterministic"], {"level": 4, "opacity": "deterministic"}),
+        (["--footprint", "3", "--order", "unsorted"], {"footprint": 3.0, "order": "unsorted"}),
+    ],
+)
+def test_same_bits_as_cli_pfm(cli, demo, tmp_path, args, kwargs):
+    out = tmp_path / "x.pfm"
+    stats = tmp_path / "x.json"
+    subprocess.run(
+        [cli, "render", "builtin:demo", "--width", "40", "--height", "30", "--spp", "3",
+         "--seed", "7", "--threads", "2", "--out", str(out), "--stats", str(stats), *args],
+        check=True, capture_output=True)
+    r = demo.render(width=40, height=30, spp=3, seed=7, threads=1, **kwargs)
+    cli_image = read_pfm(out)
+    assert r.image.shape == cli_image.shape
+    assert np.array_equal(r.image.view(np.uint32), cli_image.view(np.uint32))
+    cli_stats = json.loads(stats.read_text())
+    assert set(r.stats) == set(cli_stats)
+    assert r.stats["tests"] == cli_stats["tests"]
+    assert r.stats["rays"] == cli_stats["rays"]
+    assert r.stats["per_primary_ray"] == cli_stats["per_primary_ray"]
+
+
+def test_shapes_and_dtypes(demo):
+    r = demo.render(width=20, height=10, spp=2)
+    assert (r.width, r.height, r.spp, r.spp_requested, r.interrupted) == (20, 10, 2, 2, False)
+    for name, dtype, shape in [("image", np.float32, (10, 20, 3)), ("normal", np.float32, (10, 20, 3)),
+                               ("albedo", np.float32, (10, 20, 3)), ("cost", np.float64, (10, 20)),
+                               ("tests", np.uint64, (10, 20)), ("depth", np.float32, (10, 20)),
+                               ("level", np.float32, (10, 20))]:
+        a = getattr(r, name)
+        assert a.dtype == dtype, name
+        assert a.shape == shape, name
+    # cost is tests per pixel over spp, and the totals are the stats' exact count.
+    assert np.array_equal(r.cost, r.tests / 2.0)
+    assert int(r.tests.sum()) == r.stats["tests"]["total"]
+    assert r.stats["width"] == 20 and r.stats["height"] == 10 and r.stats["spp"] == 2
+    assert np.isfinite(r.image).all() and (r.image >= 0).all()
+
+
+def test_one_scene_many_renders(demo):
+    a = demo.render(width=16, height=16, spp=2, seed=1)
+    b = demo.render(width=24, height=8, spp=1, seed=2, renderer="traditional")
+    c = demo.render(width=16, height=16, spp=2, seed=1)
+    assert b.image.shape == (8, 24, 3)
+    assert np.array_equal(a.image, c.image) and np.array_equal(a.tests, c.tests)
+    assert demo.last_result is not None and np.array_equal(demo.last_result.image, c.image)
+    d = demo.render(width=16, height=16, spp=2, seed=3)
+    assert not np.array_equal(a.image, d.image)  # the seed matters
+
+
+def test_two_python_threads_at_once(demo):
+    kwargs = [dict(width=64, height=48, spp=4, seed=5), dict(width=48, height=64, spp=3, seed=6,
+                                                             opacity="deterministic")]
+    sequential = [demo.render(**k) for k in kwargs]
+    results = [None, None]
+    errors = []
+
+    def run(i):
+        try:
+            results[i] = demo.render(**kwargs[i])
+        except Exception as e:  # reported below, not lost in the thread
+            errors.append(e)
+
+    threads = [threading.Thread(target=run, args=(i,)) for i in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+    for s, r in zip(sequential, results):
+        assert np.array_equal(s.image.view(np.uint32), r.image.view(np.uint32))
+        assert np.array_equal(s.tests, r.tests)
+        assert s.stats["tests"] == r.stats["tests"]
+
+
+def test_load_with_parameters():
+    s = amalgam.load("builtin:line", n=4, depth=3)
+    assert s.levels == 4
+    r = s.render(width=8, height=8, spp=1)
+    assert r.stats["scene"]["name"].startswith("builtin:line")
+
+
+def test_trace(demo, cli):
+    t = demo.trace()
+    out = subprocess.run([cli, "trace", "builtin:demo"], check=True, capture_output=True,
+                         text=True).stdout
+    expected = json.loads(out)
+    assert t["hit"] == expected["hit"]
+    assert t["tests"] == expected["tests"] and t["rays"] == expected["rays"]
+    miss = demo.trace(origin=[0, 0, 100], direction=[0, 0, 1])
+    assert miss["hit"] is None and miss["tests"]["total"] >= 0
+
+
+def test_compare(demo):
+    a = demo.render(width=32, height=32, spp=1, seed=1)
+    b = demo.render(width=32, height=32, spp=8, seed=2)
+    same = amalgam.compare(a, a.image)
+    assert same["rmse"] == 0 and same["ssim"] == 1 and same["psnr"] == float("inf")
+    m = amalgam.compare(a, b)
+    assert set(m) == {"width", "height", "rmse", "psnr", "ssim", "mean_abs", "max_abs", "rel_mse"}
+    diff = a.image.astype(np.float64) - b.image
+    assert m["rmse"] == pytest.approx(np.sqrt(np.mean(diff * diff)), rel=1e-9)
+    assert m["max_abs"] == pytest.approx(np.abs(diff).max(), rel=1e-6)
+
+
+def test_experiment():
+    rows = amalgam.experiment("linear-cost", quick=True)
+    assert rows and isinstance(rows[0], dict)
+    assert all(set(r) == set(rows[0]) for r in rows)
+    assert all(isinstance(v, float) for v in rows[0].values())
