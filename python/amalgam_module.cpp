@@ -339,7 +339,7 @@ PYBIND11_MODULE(amalgam, m) {
   m.doc() =
       "amalgam: a ray tracer after Thompson & Fussell 1991, 'Time Costs of Ray Tracing with\n"
       "Amalgams', with exact cost statistics.\n\n"
-      "  scene = amalgam.load('builtin:tube', n=64)       # built and baked once\n"
+      "  scene = amalgam.load('builtin:line', n=4)        # built and baked once\n"
       "  r = scene.render(width=256, height=256, spp=4)   # r.image: float32 H x W x 3\n"
       "  r.cost, r.stats                                  # tests per pixel, stats dict\n"
       "  amalgam.compare(r, reference)                    # rmse, psnr, ssim, ...\n"
