@@ -67,8 +67,18 @@ class Scene:
     ) -> dict[str, Any]:
         """One primary ray with its shadow rays: 'hit', 'colour' and the counts."""
 
-def load(scene: str, **params: Union[int, float, str]) -> Scene:
-    """'builtin:NAME' with parameters as keywords, a scene .json, or a mesh path."""
+def load(
+    scene: str,
+    *,
+    camera: Union[str, int] = ...,
+    eye: Sequence[float] = ...,
+    look_at: Sequence[float] = ...,
+    up: Sequence[float] = ...,
+    fov: float = ...,
+    **params: Union[int, float, str],
+) -> Scene:
+    """'builtin:NAME' with parameters as keywords, a scene .json, or a mesh path; the view
+    keywords are the CLI's --camera, --eye, --look-at, --up, --fov."""
 
 def compare(
     a: Union[RenderResult, npt.ArrayLike], b: Union[RenderResult, npt.ArrayLike]

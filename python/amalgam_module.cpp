@@ -256,15 +256,56 @@ struct Scene {
   }
 };
 
+/// A view keyword of `load` (eye=, look_at=, up=) as a Vec3; the CLI's message otherwise.
+Vec3 view_vec(const py::handle& v, const std::string& option) {
+  std::vector<float> x;
+  try {
+    x = v.cast<std::vector<float>>();
+  } catch (const py::cast_error&) {
+  }
+  const std::string text = py::str(v).cast<std::string>();
+  if (x.size() != 3 || !is_finite(Vec3{x[0], x[1], x[2]}))
+    throw InputError(option + " '" + text + "': expected three numbers x,y,z");
+  return {x[0], x[1], x[2]};
+}
+
 std::shared_ptr<Scene> load(const std::string& spec, const py::kwargs& params) {
+  // The view keywords are the CLI's --camera, --eye, --look-at, --up and --fov (no builtin
+  // has a parameter of these names); the others are builtin parameters (--set key=value).
   Params p(spec);
-  for (auto item : params)
-    p.set(py::str(item.first).cast<std::string>(), py::str(item.second).cast<std::string>());
+  CameraChoice view;
+  for (auto item : params) {
+    const std::string key = py::str(item.first).cast<std::string>();
+    if (key == "camera") {
+      view.camera = py::str(item.second).cast<std::string>();
+    } else if (key == "eye") {
+      view.eye = view_vec(item.second, "--eye");
+    } else if (key == "look_at") {
+      view.look_at = view_vec(item.second, "--look-at");
+    } else if (key == "up") {
+      view.up = view_vec(item.second, "--up");
+    } else if (key == "fov") {
+      const std::string text = py::str(item.second).cast<std::string>();
+      double x = NAN;
+      try {
+        x = item.second.cast<double>();
+      } catch (const py::cast_error&) {
+      }
+      if (!(x > 0.0 && x < 180.0))
+        throw InputError("--fov " + one_line(text, 40) +
+                         ": expected a vertical field of view in degrees, > 0 and < 180");
+      view.fov_deg = static_cast<float>(x);
+    } else {
+      p.set(key, py::str(item.second).cast<std::string>());
+    }
+  }
   auto s = std::make_shared<Scene>();
   s->spec = spec;
   {
     py::gil_scoped_release nogil;
-    s->scene = std::make_shared<const LoadedScene>(load_scene(spec, p));
+    LoadedScene loaded = load_scene(spec, p);
+    choose_camera(loaded, view);
+    s->scene = std::make_shared<const LoadedScene>(std::move(loaded));
   }
   return s;
 }
@@ -430,8 +471,10 @@ PYBIND11_MODULE(amalgam, m) {
   m.def("load", &load, py::arg("scene"),
         "load(scene, **params) -> Scene\n\n"
         "Loads, builds and bakes a scene: 'builtin:NAME' with its parameters as keyword\n"
-        "arguments (the CLI's --set key=value, e.g. load('builtin:tube', n=64)), a scene .json,\n"
-        "or a mesh path. Raises ValueError with the CLI's message on bad input.");
+        "arguments (the CLI's --set key=value, e.g. load('builtin:line', n=4)), a scene .json,\n"
+        "or a mesh path. The view keywords camera= (name or index), eye=, look_at=, up=\n"
+        "(x, y, z) and fov= (degrees) are the CLI's --camera, --eye, --look-at, --up, --fov.\n"
+        "Raises ValueError with the CLI's message on bad input.");
   m.def("compare", &compare, py::arg("a"), py::arg("b"),
         "compare(a, b) -> dict\n\n"
         "Image metrics of `amalgam compare` for two H x W x 3 images (arrays or RenderResults),\n"

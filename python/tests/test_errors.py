@@ -88,3 +88,16 @@ def test_help_shows_the_api():
     assert "load" in doc and "render" in doc
     assert "KeyboardInterrupt" in amalgam.Scene.render.__doc__
     assert amalgam.load.__doc__.startswith("load(")
+
+
+def test_bad_view_keywords_are_value_errors(cli, tmp_path):
+    message, status = cli_message(cli, "render", "builtin:demo", "--fov", "200", "--out",
+                                  str(tmp_path / "x.pfm"))
+    assert status == 2
+    with pytest.raises(ValueError) as e:
+        amalgam.load("builtin:demo", fov=200)
+    assert str(e.value) == message
+    with pytest.raises(ValueError, match="--eye"):
+        amalgam.load("builtin:demo", eye=(1, 2))
+    with pytest.raises(ValueError, match="--camera"):
+        amalgam.load("builtin:demo", camera="nope")

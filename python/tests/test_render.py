@@ -138,3 +138,15 @@ def test_experiment():
     assert rows and isinstance(rows[0], dict)
     assert all(set(r) == set(rows[0]) for r in rows)
     assert all(isinstance(v, float) for v in rows[0].values())
+
+
+def test_view_keywords_as_cli(cli, tmp_path):
+    out = tmp_path / "v.pfm"
+    view = ["--eye", "0.5,0.5,3", "--look-at", "0.5,0.5,0.5", "--fov", "30"]
+    subprocess.run([cli, "render", "builtin:demo", "--width", "24", "--height", "16", "--spp",
+                    "2", "--out", str(out), *view], check=True, capture_output=True)
+    s = amalgam.load("builtin:demo", eye=(0.5, 0.5, 3), look_at=[0.5, 0.5, 0.5], fov=30)
+    r = s.render(width=24, height=16, spp=2)
+    assert np.array_equal(r.image.view(np.uint32), read_pfm(out).view(np.uint32))
+    default = amalgam.load("builtin:demo").render(width=24, height=16, spp=2)
+    assert not np.array_equal(r.image, default.image)
