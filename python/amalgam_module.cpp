@@ -5,6 +5,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <atomic>
@@ -55,10 +56,9 @@ py::object to_python(const nlohmann::json& j) {
   return py::module_::import("json").attr("loads")(j.dump());
 }
 
-/// Render options and view, checked.
+/// Render options, checked.
 struct Options {
   RenderOptions o;
-  CameraChoice view;
 };
 
 Options make_options(int width, int height, int spp, const std::string& renderer,
@@ -127,6 +127,9 @@ std::shared_ptr<RenderResult> make_result(const LoadedScene& scene, const Render
   run.height = r.height;
   run.spp = r.spp;
   run.threads = render_threads(o);
+  rusage u{};  // the process's peak resident memory, as the CLI reports it (Linux: KiB)
+  if (getrusage(RUSAGE_SELF, &u) == 0)
+    run.peak_memory_bytes = static_cast<std::uint64_t>(u.ru_maxrss) * 1024;
   run.cost_range = own_range(r.cost);
   add_run_info(j, run);
   res->stats = to_python(j);

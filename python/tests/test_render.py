@@ -64,6 +64,7 @@ def test_shapes_and_dtypes(demo):
     assert np.array_equal(r.cost, r.tests / 2.0)
     assert int(r.tests.sum()) == r.stats["tests"]["total"]
     assert r.stats["width"] == 20 and r.stats["height"] == 10 and r.stats["spp"] == 2
+    assert r.stats["peak_memory_bytes"] > 0
     assert np.isfinite(r.image).all() and (r.image >= 0).all()
 
 
