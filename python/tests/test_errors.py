@@ -61,14 +61,31 @@ def test_bad_options_are_value_errors(demo, tmp_path):
 
 
 def test_keyboard_interrupt_stops_render(demo):
-    # A render of minutes, interrupted by SIGINT after half a second.
+    # A render of minutes, interrupted by SIGINT after half a second. Meanwhile another Python
+    # thread ticks every 10 ms: it can only run if the render released the GIL.
+    ticks = []
+    rendering = threading.Event()
+    stop = threading.Event()
+
+    def tick():
+        while not stop.wait(0.01):
+            if rendering.is_set():
+                ticks.append(1)
+
+    ticker = threading.Thread(target=tick)
+    ticker.start()
     timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
     timer.start()
     try:
         with pytest.raises(KeyboardInterrupt) as e:
+            rendering.set()
             demo.render(width=256, height=256, spp=5000, seed=1)
     finally:
+        rendering.clear()
+        stop.set()
         timer.cancel()
+        ticker.join()
+    assert len(ticks) >= 10  # about 50 in the half second: the GIL was free
     partial = e.value.partial
     assert partial is demo.last_result
     # Stopped early: 5000 samples would take minutes.
