@@ -21,6 +21,7 @@ struct CommonOptions {
   int level = -1;
   float footprint = 1.0f;
   std::string seed = "0";
+  std::string sampler = "independent";  ///< render only (registered in main.cpp)
   int threads = 0;
   RenderOptions options;
   CLI::Option* level_option = nullptr;

@@ -58,6 +58,8 @@ std::string fingerprint(const CommonOptions& c, const LoadedScene& scene) {
     f << " --level " << *o.level;
   else
     f << " --footprint " << o.footprint;
+  // Only when not the default, so checkpoints written before the option existed still resume.
+  if (o.sampler == PixelSampler::kStratified) f << " --sampler stratified";
   return f.str();
 }
 

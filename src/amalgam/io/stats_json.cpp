@@ -14,6 +14,7 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
   j["footprint"] = (ss && !o.level) ? json(o.footprint) : json(nullptr);
   j["order"] = o.sorted ? "sorted" : "unsorted";
   j["seed"] = o.seed;
+  j["sampler"] = o.sampler == PixelSampler::kStratified ? "stratified" : "independent";
   j["scene"] = {{"name", scene.name},
                 {"primitives", info.primitives},
                 {"nodes", info.nodes},

@@ -11,9 +11,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <tuple>
 #include <vector>
 
 #include "amalgam/math/random.h"
+#include "amalgam/math/sobol.h"
 #include "amalgam/render/render.h"
 #include "amalgam/util/isa.h"
 
@@ -23,9 +25,11 @@ AMALGAM_ISA_BEGIN
 /// Adds samples st.spp_done .. o.spp - 1 to `st` (sized for o.width x o.height), in passes of
 /// whole samples per pixel over 8x8 tiles on o.threads threads (0: all). Pixel (x, y),
 /// sample s uses the random stream hash(o.seed, y * width + x, s), so the result does not
-/// depend on the thread count. `make(counters)` returns an integrator for one tile (an object
-/// with `li(ray, key)` returning a SampleResult) that counts its tests into `counters`.
-/// Returns whether control.cancel stopped the render early.
+/// depend on the thread count. Its position in the pixel comes from that stream
+/// (PixelSampler::kIndependent) or is point s of the pixel's scrambled Sobol sequence
+/// (kStratified), a function of (o.seed, pixel, s) too. `make(counters)` returns an integrator for
+/// one tile (an object with `li(ray, key)` returning a SampleResult) that counts its tests into
+/// `counters`. Returns whether control.cancel stopped the render early.
 template <class MakeIntegrator>
 bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
                    const RenderControl& control, MakeIntegrator&& make) {
@@ -42,6 +46,7 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
   const int cores = tbb::this_task_arena::max_concurrency();
   const int threads = o.threads > 0 ? std::min(o.threads, cores) : cores;
   tbb::task_arena arena(threads);
+  const bool stratified = o.sampler == PixelSampler::kStratified;
   std::vector<Vec3> pass_sum;
   std::vector<std::uint64_t> pass_tests;
   while (st.spp_done < o.spp) {
@@ -51,38 +56,46 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
     tbb::enumerable_thread_specific<ThreadState> states;
     std::atomic<bool> stopped{false};
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range2d<int>(0, o.height, 8, 0, o.width, 8),
-                        [&](const tbb::blocked_range2d<int>& r) {
-                          if (control.cancel && control.cancel->load(std::memory_order_relaxed)) {
-                            stopped.store(true, std::memory_order_relaxed);
-                            return;
-                          }
-                          ThreadState& ts = states.local();
-                          auto integrator = make(ts.counters);
-                          for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
-                            for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
-                              const std::size_t pix = static_cast<std::size_t>(y) * o.width + x;
-                              const std::uint64_t pixel_key = hash_combine(o.seed, pix);
-                              Vec3 sum = pass_sum[pix];
-                              std::uint64_t tests = 0;
-                              for (int s = s0; s < s1; ++s) {
-                                const std::uint64_t key =
-                                    hash_combine(pixel_key, static_cast<std::uint64_t>(s));
-                                Sampler jitter(hash_combine(key, 0x6a177e5));
-                                const float fx = static_cast<float>(x) + jitter.next();
-                                const float fy = static_cast<float>(y) + jitter.next();
-                                const Ray ray = camera.generate(fx, fy, o.width, o.height);
-                                const std::uint64_t before = ts.counters.total();
-                                sum += integrator.li(ray, key).colour;
-                                const std::uint64_t cost = ts.counters.total() - before;
-                                ts.per_primary.add(cost);
-                                tests += cost;
-                              }
-                              pass_sum[pix] = sum;
-                              pass_tests[pix] += tests;
-                            }
-                          }
-                        });
+      tbb::parallel_for(
+          tbb::blocked_range2d<int>(0, o.height, 8, 0, o.width, 8),
+          [&](const tbb::blocked_range2d<int>& r) {
+            if (control.cancel && control.cancel->load(std::memory_order_relaxed)) {
+              stopped.store(true, std::memory_order_relaxed);
+              return;
+            }
+            ThreadState& ts = states.local();
+            auto integrator = make(ts.counters);
+            for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
+              for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+                const std::size_t pix = static_cast<std::size_t>(y) * o.width + x;
+                const std::uint64_t pixel_key = hash_combine(o.seed, pix);
+                const std::uint64_t scramble = hash_combine(pixel_key, 0x50b01);
+                Vec3 sum = pass_sum[pix];
+                std::uint64_t tests = 0;
+                for (int s = s0; s < s1; ++s) {
+                  const std::uint64_t key = hash_combine(pixel_key, static_cast<std::uint64_t>(s));
+                  float jx, jy;
+                  if (stratified) {
+                    std::tie(jx, jy) = scrambled_sobol_2d(static_cast<std::uint32_t>(s), scramble);
+                  } else {
+                    Sampler jitter(hash_combine(key, 0x6a177e5));
+                    jx = jitter.next();
+                    jy = jitter.next();
+                  }
+                  const float fx = static_cast<float>(x) + jx;
+                  const float fy = static_cast<float>(y) + jy;
+                  const Ray ray = camera.generate(fx, fy, o.width, o.height);
+                  const std::uint64_t before = ts.counters.total();
+                  sum += integrator.li(ray, key).colour;
+                  const std::uint64_t cost = ts.counters.total() - before;
+                  ts.per_primary.add(cost);
+                  tests += cost;
+                }
+                pass_sum[pix] = sum;
+                pass_tests[pix] += tests;
+              }
+            }
+          });
     });
     if (stopped.load()) return true;  // the pass is incomplete: discard it
     st.sum.swap(pass_sum);
