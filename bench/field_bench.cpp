@@ -56,6 +56,7 @@
 #include "amalgam/render/integrator.h"
 #include "amalgam/render/passes.h"
 #include "amalgam/render/render.h"
+#include "embree_field.h"
 
 namespace amalgam {
 namespace {
@@ -64,176 +65,6 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
-
-void embree_error(void*, RTCError code, const char* str) {
-  std::fprintf(stderr, "field_bench: embree error %d: %s\n", static_cast<int>(code), str);
-  std::exit(1);
-}
-
-/// The instanced hierarchy's geometry in Embree: one scene per mesh, one instance geometry
-/// per instance (geometry ID = instance index).
-class EmbreeField {
- public:
-  explicit EmbreeField(const InstancedHierarchy& h) {
-    const auto t0 = Clock::now();
-    device_ = rtcNewDevice(nullptr);
-    rtcSetDeviceErrorFunction(device_, embree_error, nullptr);
-    for (const ExplicitHierarchy& mesh : h.meshes) add_mesh(mesh);
-    top_ = rtcNewScene(device_);
-    rtcSetSceneBuildQuality(top_, RTC_BUILD_QUALITY_HIGH);
-    for (std::size_t i = 0; i < h.instances.size(); ++i) {
-      const InstancedHierarchy::InstanceData& in = h.instances[i];
-      RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
-      rtcSetGeometryInstancedScene(g, meshes_[in.mesh]);
-      rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &in.to_world.m[0][0]);
-      rtcCommitGeometry(g);
-      rtcAttachGeometryByID(top_, g, static_cast<unsigned>(i));
-      rtcReleaseGeometry(g);
-    }
-    rtcCommitScene(top_);
-    build_seconds = seconds_since(t0);
-  }
-  ~EmbreeField() {
-    rtcReleaseScene(top_);
-    for (RTCScene s : meshes_) rtcReleaseScene(s);
-    rtcReleaseDevice(device_);
-  }
-  EmbreeField(const EmbreeField&) = delete;
-  EmbreeField& operator=(const EmbreeField&) = delete;
-
-  RTCScene scene() const { return top_; }
-  /// The mesh primitive an Embree triangle of mesh `m` came from.
-  std::uint32_t prim(std::uint32_t m, std::uint32_t tri) const { return prim_of_tri_[m][tri]; }
-
-  double build_seconds = 0.0;
-
- private:
-  void add_mesh(const ExplicitHierarchy& mesh) {
-    std::vector<float> v;
-    std::vector<std::uint32_t> idx, owner;
-    auto tri = [&](Vec3 a, Vec3 b, Vec3 c, std::uint32_t p) {
-      for (Vec3 q : {a, b, c}) {
-        idx.push_back(static_cast<std::uint32_t>(v.size() / 3));
-        v.insert(v.end(), {q.x, q.y, q.z});
-      }
-      owner.push_back(p);
-    };
-    for (std::uint32_t p = 0; p < mesh.prims.size(); ++p) {
-      const Primitive& q = mesh.prims[p];
-      if (q.kind == PrimKind::kTriangle) {
-        tri(q.a, q.b, q.c, p);
-      } else if (q.kind == PrimKind::kBox) {
-        const Vec3 lo = q.a, hi = q.b;
-        auto corner = [&](int i) {
-          return Vec3{i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z};
-        };
-        // Two triangles per face: corners differing in one bit from a face's base corner.
-        static constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4},
-                                             {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
-        for (const auto& f : kFaces) {
-          tri(corner(f[0]), corner(f[1]), corner(f[2]), p);
-          tri(corner(f[0]), corner(f[2]), corner(f[3]), p);
-        }
-      } else {
-        std::fprintf(stderr, "field_bench: spheres are not supported in the Embree scene\n");
-        std::exit(1);
-      }
-    }
-    RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
-        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), v.size() / 3));
-    std::copy(v.begin(), v.end(), vb);
-    auto* ib = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(
-        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(std::uint32_t), idx.size() / 3));
-    std::copy(idx.begin(), idx.end(), ib);
-    rtcCommitGeometry(g);
-    RTCScene s = rtcNewScene(device_);
-    rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
-    rtcAttachGeometry(s, g);
-    rtcReleaseGeometry(g);
-    rtcCommitScene(s);
-    meshes_.push_back(s);
-    prim_of_tri_.push_back(std::move(owner));
-  }
-
-  RTCDevice device_ = nullptr;
-  RTCScene top_ = nullptr;
-  std::vector<RTCScene> meshes_;
-  std::vector<std::vector<std::uint32_t>> prim_of_tri_;
-};
-
-/// The Integrator's tracer over Embree (full detail: every primitive opaque, no amalgams).
-class EmbreeTracer {
- public:
-  EmbreeTracer(const InstancedHierarchy& h, const EmbreeField& f) : h_(&h), f_(&f) {}
-
-  TraceHit intersect(const Ray& ray, std::uint64_t, std::vector<TranslucentHit>*) {
-    RTCRayHit rh{};
-    fill(rh.ray, ray);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    rtcIntersect1(f_->scene(), &ctx, &rh);
-    TraceHit hit;
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
-    const std::uint32_t inst = rh.hit.instID[0];
-    const std::uint32_t local = f_->prim(h_->instances[inst].mesh, rh.hit.primID);
-    hit.kind = TraceHit::Kind::kPrimitive;
-    hit.id = InstancedHierarchy::id(inst + 1ull, local);
-    hit.t = rh.ray.tfar;
-    // amalgam's own test of the one primitive Embree found gives the surface (normal, point
-    // and its error bound) exactly as the traditional renderer would see it.
-    Ray again = ray;
-    again.tmax = std::min(ray.tmax, rh.ray.tfar * (1.0f + 8.0f * gamma(3)));
-    if (auto s = h_->intersect(hit.id, again)) {
-      hit.surf = *s;
-      hit.t = s->t;
-      return hit;
-    }
-    // Embree's and amalgam's watertight tests disagree on an edge: Embree's hit as it is.
-    const InstancedHierarchy::InstanceData& in = h_->instances[inst];
-    const Vec3 ng{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
-    Vec3 n = normalize(
-        Vec3{dot(in.normal_rows[0], ng), dot(in.normal_rows[1], ng), dot(in.normal_rows[2], ng)});
-    if (dot(n, ray.dir) > 0.0f) n = -n;
-    hit.surf.t = hit.t;
-    hit.surf.normal = n;
-    hit.surf.p = ray.at(hit.t);
-    hit.surf.p_error = abs(hit.surf.p) * (64.0f * gamma(1));
-    return hit;
-  }
-
-  float transmittance(const Ray& ray, std::uint64_t) {
-    RTCRay r{};
-    fill(r, ray);
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    rtcOccluded1(f_->scene(), &ctx, &r);
-    return r.tfar < 0.0f ? 0.0f : 1.0f;
-  }
-
- private:
-  static void fill(RTCRay& r, const Ray& ray) {
-    r.org_x = ray.origin.x;
-    r.org_y = ray.origin.y;
-    r.org_z = ray.origin.z;
-    r.dir_x = ray.dir.x;
-    r.dir_y = ray.dir.y;
-    r.dir_z = ray.dir.z;
-    r.tnear = ray.tmin;
-    r.tfar = ray.tmax;
-    r.mask = 0xffffffffu;
-    r.time = 0.0f;
-    r.flags = 0;
-  }
-
-  const InstancedHierarchy* h_;
-  const EmbreeField* f_;
-};
-
-using EmbreeIntegrator = Integrator<InstancedHierarchy, TraditionalLod, StochasticOpacity,
-                                    SortedOrder, Counters, EmbreeTracer>;
 
 // ---- scenes ----------------------------------------------------------------------------------
 
@@ -290,7 +121,9 @@ std::unique_ptr<Field> make_field(long count, int subdivide, const View& view) {
   f->our_build_s = seconds_since(t0);
   const auto& h = std::get<InstancedHierarchy>(f->scene.hierarchy);
   f->triangles = f->scene.info().primitives;
-  f->embree = std::make_unique<EmbreeField>(h);
+  // HIGH build quality, as this benchmark has always used (quality_bench.cpp uses Embree's
+  // default, MEDIUM).
+  f->embree = std::make_unique<EmbreeField>(h, RTC_BUILD_QUALITY_HIGH);
   return f;
 }
 
@@ -319,17 +152,9 @@ Shot ours(const Field& f, const RenderOptions& o) {
 
 Shot embree(const Field& f, const RenderOptions& o) {
   const auto& h = std::get<InstancedHierarchy>(f.scene.hierarchy);
-  FilmState st;
-  st.width = o.width;
-  st.height = o.height;
-  st.sum.assign(static_cast<std::size_t>(o.width) * o.height, Vec3{});
-  st.tests.assign(st.sum.size(), 0);
-  const auto t0 = Clock::now();
-  render_passes(f.scene.env.camera, o, st, RenderControl{}, [&](Counters&) {
-    return EmbreeIntegrator(h, f.scene.env, EmbreeTracer(h, *f.embree));
-  });
-  const double s = seconds_since(t0);
-  return {finish(st).image, s, 0.0};
+  double s = 0;
+  std::vector<Vec3> image = embree_render(h, f.scene.env, *f.embree, o, &s);
+  return {std::move(image), s, 0.0};
 }
 
 /// Runs a and b `repeat` times, interleaved, and keeps each one's fastest time.
