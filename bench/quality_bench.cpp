@@ -65,7 +65,7 @@ struct Args {
   std::string cache = "build/yardstick/cache";
   std::string spps = "1,2,4,8,16,32,64", ks = "1,4,16", oracle_ks = "1,4,16";
   int width = 512, height = 384, threads = 2, runs = 3;
-  int ref_max_spp = 1024, ref_batches = 8, oracle_rays = 64, oracle_spp = 4, oracle_runs = 2;
+  int ref_max_spp = 1024, ref_batches = 8, oracle_rays = 64, oracle_spp = 2, oracle_runs = 2;
   double ref_se = 0.002;
   bool quick = false, no_embree = false;
 };
