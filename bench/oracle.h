@@ -21,6 +21,10 @@
 // - Primary visibility and shading are filtered; shadow rays stay at full detail (an ideal
 //   amalgam on a shadow ray would average transmittance over the shadow beam, which this bound
 //   leaves exact).
+// - The disc's diameter: K x the pixel footprint at t (`box_disc` false: the width the LOD
+//   test compares amalgams with, the brief's definition), or the diagonal of the amalgam's box
+//   (`box_disc` true: never wider, since the test renders only boxes below K footprints; what
+//   one value per amalgam, centred on the ray, would average over).
 // Its time means nothing (a sample in an amalgam costs `rays` full-detail samples).
 
 #include <atomic>
@@ -46,9 +50,11 @@ class OracleIntegrator {
   using Full = Integrator<H, TraditionalLod, StochasticOpacity, SortedOrder, Counters>;
 
   /// `in_amalgam` counts the samples replaced by the brute-force estimate.
-  OracleIntegrator(const H& h, const Environment& env, float footprint, int rays,
+  OracleIntegrator(const H& h, const Environment& env, float footprint, int rays, bool box_disc,
                    Counters& counters, std::atomic<std::uint64_t>& in_amalgam)
-      : find_(h, FootprintLod{footprint}, counters),
+      : h_(&h),
+        box_disc_(box_disc),
+        find_(h, FootprintLod{footprint}, counters),
         full_(h, env, TraditionalLod{}, counters),
         k_(footprint),
         rays_(rays),
@@ -59,7 +65,7 @@ class OracleIntegrator {
     if (hit.kind != TraceHit::Kind::kAmalgam) return full_.li(primary, key);
     in_amalgam_->fetch_add(1, std::memory_order_relaxed);
     const float t = hit.t;
-    const float width = k_ * primary.footprint(t);
+    const float width = box_disc_ ? h_->bounds(hit.id).diagonal() : k_ * primary.footprint(t);
     const Vec3 d = primary.dir;
     const Vec3 a = std::fabs(d.x) > 0.5f ? Vec3{0, 1, 0} : Vec3{1, 0, 0};
     const Vec3 u = normalize(cross(d, a)), v = cross(d, u);
@@ -82,6 +88,8 @@ class OracleIntegrator {
   }
 
  private:
+  const H* h_;
+  bool box_disc_;
   Find find_;
   Full full_;
   float k_;

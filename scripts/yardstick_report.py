@@ -64,8 +64,10 @@ def plot_error(res, path):
                                 xytext=(2, 2), textcoords="offset points")
         for o in res["oracle"]:
             name = f"scale-sensitive K={float(o['K']):g}"
-            ax.axhline(max(o["bias"], 1e-5), color=colour_of(name, ks), ls=":", lw=1.5,
-                       label=f"oracle K={float(o['K']):g} (LOD floor: its bias)")
+            box = o.get("disc") == "box"
+            ax.axhline(max(o["bias"], 1e-5), color=colour_of(name, ks), ls=(0, (1, 3)) if box else ":",
+                       lw=1.0 if box else 1.8,
+                       label=f"{oracle_name(o)} (LOD floor: its bias)")
         ax.axhline(target, color="black", ls="--", lw=0.8,
                    label=f"traditional 16 spp RMSE {target:.4f}")
         if key == "bias":
@@ -91,7 +93,7 @@ def plot_tiles(res, path):
         if row["spp"] == 16 and row["renderer"] != "embree":
             panels.append((f"{label(row)}, 16 spp", row["tiles"]))
     for o in res["oracle"]:
-        panels.append((f"oracle K={float(o['K']):g}", o["tiles"]))
+        panels.append((oracle_name(o), o["tiles"]))
     if not panels:
         return
     n = len(panels)
@@ -115,6 +117,11 @@ def plot_tiles(res, path):
                  fontsize=9)
     fig.savefig(path, dpi=100)
     plt.close(fig)
+
+
+def oracle_name(o):
+    box = " box disc" if o.get("disc") == "box" else ""
+    return f"oracle K={float(o['K']):g}{box}"
 
 
 def fmt(x, p=4):
@@ -172,12 +179,13 @@ def section(res, img_rel):
             "samples); \"in amalgams\": the share of primary samples that met a renderable "
             "amalgam and were replaced by the brute-force estimate.")
         out.append("")
-        out.append("| K | spp x rays | in amalgams | RMSE | bias (floor) | bias / 16-spp RMSE | "
+        out.append("| K | disc | spp x rays | in amalgams | RMSE | bias (floor) | bias / 16-spp RMSE | "
                    "std | worst tile | tiles within 3 % |")
-        out.append("|---|---|---|---|---|---|---|---|---|")
+        out.append("|---|---|---|---|---|---|---|---|---|---|")
         for o in res["oracle"]:
+            disc = "box diagonal" if o.get("disc") == "box" else "K footprints"
             out.append(
-                f"| {float(o['K']):g} | {o['spp']} x {o['rays']} ({o['runs']} runs) | "
+                f"| {float(o['K']):g} | {disc} | {o['spp']} x {o['rays']} ({o['runs']} runs) | "
                 f"{100 * o['in_amalgam']:.0f} % | {fmt(o['rmse'])} | {fmt(o['bias'])} | "
                 f"{o['bias'] / eq['rmse']:.2f} | {fmt(o['stddev'])} | "
                 f"{100 * o['tile_worst']:+.1f} % | {100 * o['tile_within3']:.0f} % |")
@@ -222,7 +230,7 @@ def targets(results):
                 f"({label(lb)}, {lb['spp']} spp) | {'yes' if lb['bias'] < eq['rmse'] / 2 else 'no'} |")
         for o in res["oracle"]:
             out.append(
-                f"| {v} | (reachable?) oracle K={float(o['K']):g}: LOD floor below half of "
+                f"| {v} | (reachable?) {oracle_name(o)}: LOD floor below half of "
                 f"{eq['rmse']:.4f} | bias {o['bias']:.4f} | "
                 f"{'reachable' if o['bias'] < eq['rmse'] / 2 else 'not at this K'} |")
     out.append("")
