@@ -3,7 +3,7 @@
 # scale-sensitive renderers and Embree, against a converged reference, with the oracle bound
 # of level of detail; on the field's street and aerial views.
 #
-#   scripts/yardstick.sh            full run (about 15-20 minutes on 2 idle cores; the
+#   scripts/yardstick.sh            full run (about 10-20 minutes on 2 cores; the
 #                                   references are cached in build/yardstick/cache, so reruns
 #                                   save about a third): writes docs/yardstick/*.png and
 #                                   *.csv/json and the generated part of docs/yardstick.md
@@ -13,8 +13,8 @@
 # Environment: BENCH (default build/bench/amalgam_quality_bench), SCENE (scenes/field.json),
 # VIEWS ("aerial street"), THREADS (2), WORK (build/yardstick: results and the reference
 # cache), DOCS (docs/yardstick), DOC (docs/yardstick.md), BENCH_ARGS (more bench options, e.g.
-# "--footprints 1,4 --spps 1,4,16"), BENCH_ARGS_<view> (options for one view only; default
-# BENCH_ARGS_aerial="--oracle-box": the box-disc oracle too, cheap there).
+# "--footprints 1,4 --spps 1,4,16"; the script adds --oracle-box, the box-disc oracle beside
+# the K-footprint one), BENCH_ARGS_<view> (options for one view only).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -26,6 +26,7 @@ WORK=${WORK:-build/yardstick}
 DOCS=${DOCS:-docs/yardstick}
 DOC=${DOC:-docs/yardstick.md}
 read -r -a extra <<<"${BENCH_ARGS:-}"
+extra+=(--oracle-box)
 quick=()
 if [[ "${1:-}" == "--quick" ]]; then
   quick=(--quick)
@@ -39,7 +40,6 @@ fi
   { echo "yardstick: python3 matplotlib not found (apt-get install python3-matplotlib)" >&2; exit 1; }
 
 dirs=()
-BENCH_ARGS_aerial=${BENCH_ARGS_aerial-"--oracle-box"}
 command="scripts/yardstick.sh"
 [[ -n "${BENCH_ARGS:-}" ]] && command+=" (BENCH_ARGS=\"$BENCH_ARGS\")"
 for view in $VIEWS; do
