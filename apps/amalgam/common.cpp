@@ -98,6 +98,8 @@ void CommonOptions::finish() {
   options.level = level >= 0 ? std::optional<int>(level) : std::nullopt;
   options.footprint = footprint;
   options.seed = parse_seed(seed);
+  options.sampler =
+      sampler == "stratified" ? PixelSampler::kStratified : PixelSampler::kIndependent;
   options.threads = threads;
   view = CameraChoice{};
   view.camera = camera;

@@ -22,6 +22,7 @@ struct CommonOptions {
   int level = -1;
   float footprint = 1.0f;
   std::string seed = "0";
+  std::string sampler = "independent";  ///< render only (registered in main.cpp)
   int threads = 0;
   std::string tracer = "amalgam";
   RenderOptions options;

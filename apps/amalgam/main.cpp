@@ -63,6 +63,11 @@ int main(int argc, char** argv) {
       ->check(cli::positive_int());
   render->add_option("--spp", render_opts.options.spp, "samples per pixel (default 4)")
       ->check(cli::positive_int());
+  render
+      ->add_option("--sampler", render_opts.sampler,
+                   "pixel sampling: independent (default: a random point per sample) or "
+                   "stratified (scrambled Sobol points per pixel: edges converge faster)")
+      ->check(CLI::IsMember({"independent", "stratified"}));
   render->add_option("--checkpoint", extras.checkpoint,
                      "checkpoint file written when interrupted (default: OUT.ckpt)");
   render->add_flag("--resume", extras.resume,

@@ -67,6 +67,8 @@ std::string fingerprint(const CommonOptions& c, const LoadedScene& scene) {
   else
     f << " --footprint " << o.footprint;
   if (o.tracer == TracerKind::kEmbree) f << " --tracer embree";  // amalgam's: as before
+  // Only when not the default, so checkpoints written before the option existed still resume.
+  if (o.sampler == PixelSampler::kStratified) f << " --sampler stratified";
   return f.str();
 }
 

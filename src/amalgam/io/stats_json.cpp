@@ -31,6 +31,7 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
   const bool embree = o.tracer == TracerKind::kEmbree;
   j["tracer"] = embree ? "embree" : "amalgam";
   j["seed"] = o.seed;
+  j["sampler"] = o.sampler == PixelSampler::kStratified ? "stratified" : "independent";
   j["scene"] = {{"name", scene.name},
                 {"primitives", count(info.primitives)},
                 {"nodes", count(info.nodes)},

@@ -11,6 +11,11 @@ enum class OpacityKind : std::uint8_t { kStochastic, kDeterministic };
 /// What finds the hits: amalgam's traversal, or Intel Embree 3 at full detail
 /// (render/embree_tracer.h; only the traditional renderer).
 enum class TracerKind : std::uint8_t { kAmalgam, kEmbree };
+/// Where in its pixel a primary sample goes. kIndependent: a uniform random point per sample
+/// (the original sampling; every stored image and experiment uses it). kStratified: sample s
+/// of a pixel is point s of a Sobol sequence scrambled per pixel (math/sobol.h): every prefix
+/// of 2^m samples covers the pixel evenly, so edges converge faster.
+enum class PixelSampler : std::uint8_t { kIndependent, kStratified };
 
 struct RenderOptions {
   RendererKind renderer = RendererKind::kScaleSensitive;
@@ -19,6 +24,7 @@ struct RenderOptions {
   float footprint = 1.0f;    ///< scale-sensitive without level: pixels of ray footprint
   bool sorted = true;
   std::uint64_t seed = 0;
+  PixelSampler sampler = PixelSampler::kIndependent;
   int threads = 0;  ///< 0: all cores
   int width = 512;
   int height = 512;

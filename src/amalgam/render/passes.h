@@ -11,9 +11,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <tuple>
 #include <vector>
 
 #include "amalgam/math/random.h"
+#include "amalgam/math/sobol.h"
 #include "amalgam/render/integrator.h"
 #include "amalgam/render/render.h"
 #include "amalgam/util/isa.h"
@@ -38,9 +40,11 @@ inline void add_sample(PixelAov& a, const SampleResult& r) {
 /// Adds samples st.spp_done .. o.spp - 1 to `st` (sized for o.width x o.height), in passes of
 /// whole samples per pixel over 8x8 tiles on o.threads threads (0: all). Pixel (x, y),
 /// sample s uses the random stream hash(o.seed, y * width + x, s), so the result does not
-/// depend on the thread count. `make(counters)` returns an integrator for one tile (an object
-/// with `li(ray, key)` returning a SampleResult) that counts its tests into `counters`.
-/// Returns whether control.cancel stopped the render early.
+/// depend on the thread count. Its position in the pixel comes from that stream
+/// (PixelSampler::kIndependent) or is point s of the pixel's scrambled Sobol sequence
+/// (kStratified), a function of (o.seed, pixel, s) too. `make(counters)` returns an integrator for
+/// one tile (an object with `li(ray, key)` returning a SampleResult) that counts its tests into
+/// `counters`. Returns whether control.cancel stopped the render early.
 template <class MakeIntegrator>
 bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
                    const RenderControl& control, MakeIntegrator&& make) {
@@ -53,6 +57,7 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
   // small images do not pay for many passes and large ones can stop quickly.
   const int per_pass = std::max(1, static_cast<int>(65536 / std::max<std::size_t>(pixels, 1)));
   tbb::task_arena arena(render_threads(o));
+  const bool stratified = o.sampler == PixelSampler::kStratified;
   std::vector<Vec3> pass_sum;
   std::vector<std::uint64_t> pass_tests;
   std::vector<PixelAov> pass_aov;
@@ -77,15 +82,24 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
                             for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
                               const std::size_t pix = static_cast<std::size_t>(y) * o.width + x;
                               const std::uint64_t pixel_key = hash_combine(o.seed, pix);
+                              const std::uint64_t scramble = hash_combine(pixel_key, 0x50b01);
                               Vec3 sum = pass_sum[pix];
                               std::uint64_t tests = 0;
                               PixelAov aov = pass_aov[pix];
                               for (int s = s0; s < s1; ++s) {
                                 const std::uint64_t key =
                                     hash_combine(pixel_key, static_cast<std::uint64_t>(s));
-                                Sampler jitter(hash_combine(key, 0x6a177e5));
-                                const float fx = static_cast<float>(x) + jitter.next();
-                                const float fy = static_cast<float>(y) + jitter.next();
+                                float jx, jy;
+                                if (stratified) {
+                                  std::tie(jx, jy) = scrambled_sobol_2d(
+                                      static_cast<std::uint32_t>(s), scramble);
+                                } else {
+                                  Sampler jitter(hash_combine(key, 0x6a177e5));
+                                  jx = jitter.next();
+                                  jy = jitter.next();
+                                }
+                                const float fx = static_cast<float>(x) + jx;
+                                const float fy = static_cast<float>(y) + jy;
                                 const Ray ray = camera.generate(fx, fy, o.width, o.height);
                                 const std::uint64_t before = ts.counters.total();
                                 const SampleResult r = integrator.li(ray, key);
