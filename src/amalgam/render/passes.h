@@ -70,51 +70,50 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
     tbb::enumerable_thread_specific<ThreadState> states;
     std::atomic<bool> stopped{false};
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range2d<int>(0, o.height, 8, 0, o.width, 8),
-                        [&](const tbb::blocked_range2d<int>& r) {
-                          if (control.cancel && control.cancel->load(std::memory_order_relaxed)) {
-                            stopped.store(true, std::memory_order_relaxed);
-                            return;
-                          }
-                          ThreadState& ts = states.local();
-                          auto integrator = make(ts.counters);
-                          for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
-                            for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
-                              const std::size_t pix = static_cast<std::size_t>(y) * o.width + x;
-                              const std::uint64_t pixel_key = hash_combine(o.seed, pix);
-                              const std::uint64_t scramble = hash_combine(pixel_key, 0x50b01);
-                              Vec3 sum = pass_sum[pix];
-                              std::uint64_t tests = 0;
-                              PixelAov aov = pass_aov[pix];
-                              for (int s = s0; s < s1; ++s) {
-                                const std::uint64_t key =
-                                    hash_combine(pixel_key, static_cast<std::uint64_t>(s));
-                                float jx, jy;
-                                if (stratified) {
-                                  std::tie(jx, jy) = scrambled_sobol_2d(
-                                      static_cast<std::uint32_t>(s), scramble);
-                                } else {
-                                  Sampler jitter(hash_combine(key, 0x6a177e5));
-                                  jx = jitter.next();
-                                  jy = jitter.next();
-                                }
-                                const float fx = static_cast<float>(x) + jx;
-                                const float fy = static_cast<float>(y) + jy;
-                                const Ray ray = camera.generate(fx, fy, o.width, o.height);
-                                const std::uint64_t before = ts.counters.total();
-                                const SampleResult r = integrator.li(ray, key);
-                                sum += r.colour;
-                                add_sample(aov, r);
-                                const std::uint64_t cost = ts.counters.total() - before;
-                                ts.per_primary.add(cost);
-                                tests += cost;
-                              }
-                              pass_sum[pix] = sum;
-                              pass_tests[pix] += tests;
-                              pass_aov[pix] = aov;
-                            }
-                          }
-                        });
+      tbb::parallel_for(
+          tbb::blocked_range2d<int>(0, o.height, 8, 0, o.width, 8),
+          [&](const tbb::blocked_range2d<int>& r) {
+            if (control.cancel && control.cancel->load(std::memory_order_relaxed)) {
+              stopped.store(true, std::memory_order_relaxed);
+              return;
+            }
+            ThreadState& ts = states.local();
+            auto integrator = make(ts.counters);
+            for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
+              for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+                const std::size_t pix = static_cast<std::size_t>(y) * o.width + x;
+                const std::uint64_t pixel_key = hash_combine(o.seed, pix);
+                const std::uint64_t scramble = hash_combine(pixel_key, 0x50b01);
+                Vec3 sum = pass_sum[pix];
+                std::uint64_t tests = 0;
+                PixelAov aov = pass_aov[pix];
+                for (int s = s0; s < s1; ++s) {
+                  const std::uint64_t key = hash_combine(pixel_key, static_cast<std::uint64_t>(s));
+                  float jx, jy;
+                  if (stratified) {
+                    std::tie(jx, jy) = scrambled_sobol_2d(static_cast<std::uint32_t>(s), scramble);
+                  } else {
+                    Sampler jitter(hash_combine(key, 0x6a177e5));
+                    jx = jitter.next();
+                    jy = jitter.next();
+                  }
+                  const float fx = static_cast<float>(x) + jx;
+                  const float fy = static_cast<float>(y) + jy;
+                  const Ray ray = camera.generate(fx, fy, o.width, o.height);
+                  const std::uint64_t before = ts.counters.total();
+                  const SampleResult r = integrator.li(ray, key);
+                  sum += r.colour;
+                  add_sample(aov, r);
+                  const std::uint64_t cost = ts.counters.total() - before;
+                  ts.per_primary.add(cost);
+                  tests += cost;
+                }
+                pass_sum[pix] = sum;
+                pass_tests[pix] += tests;
+                pass_aov[pix] = aov;
+              }
+            }
+          });
     });
     if (stopped.load()) return true;  // the pass is incomplete: discard it
     st.sum.swap(pass_sum);
