@@ -243,19 +243,7 @@ struct Scene {
       t = amalgam::trace(*scene, opt.o, ray);
       secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
-    nlohmann::json j = stats_json(*scene, opt.o, t.counters, t.per_primary, secs);
-    if (t.hit.kind == TraceHit::Kind::kNone) {
-      j["hit"] = nullptr;
-    } else {
-      j["hit"] = {{"t", t.hit.t},
-                  {"object",
-                   {{"kind", t.hit.kind == TraceHit::Kind::kPrimitive ? "primitive" : "amalgam"},
-                    {"id", t.hit.id},
-                    {"level", t.hit.level}}},
-                  {"point", {t.hit.surf.p.x, t.hit.surf.p.y, t.hit.surf.p.z}}};
-    }
-    j["colour"] = {t.colour.x, t.colour.y, t.colour.z};
-    return to_python(j);
+    return to_python(trace_json(*scene, opt.o, t, secs));
   }
 };
 

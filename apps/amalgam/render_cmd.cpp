@@ -401,19 +401,7 @@ int run_trace(CommonOptions& common, const std::string& origin, const std::strin
   const TraceOutput t = trace(scene, common.options, ray);  // finish() refused --tracer embree
 #endif
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  nlohmann::json j =
-      stats_json(scene, common.options, t.counters, t.per_primary, secs, embree_build);
-  if (t.hit.kind == TraceHit::Kind::kNone) {
-    j["hit"] = nullptr;
-  } else {
-    j["hit"] = {{"t", t.hit.t},
-                {"object",
-                 {{"kind", t.hit.kind == TraceHit::Kind::kPrimitive ? "primitive" : "amalgam"},
-                  {"id", t.hit.id},
-                  {"level", embree ? nlohmann::json(nullptr) : nlohmann::json(t.hit.level)}}},
-                {"point", {t.hit.surf.p.x, t.hit.surf.p.y, t.hit.surf.p.z}}};
-  }
-  j["colour"] = {t.colour.x, t.colour.y, t.colour.z};
+  const nlohmann::json j = trace_json(scene, common.options, t, secs, embree_build);
   std::cout << j.dump(2) << "\n";
   return 0;
 }

@@ -37,7 +37,8 @@ CliResult run(const std::string& args) {
   return {r.status, r.out, amalgam::test::slurp(err)};
 }
 
-const std::string kOut = (fs::temp_directory_path() / "amalgam-embree-cli.pfm").string();
+// Per test process: ctest runs these tests in parallel.
+const std::string kOut = (amalgam::test::scratch_dir("amalgam-embree-cli") / "out.pfm").string();
 const std::string kRender =
     "render builtin:prisms --set depth=3 --width 16 --height 12 --spp 1 "
     "--quiet --out " +
@@ -93,7 +94,7 @@ TEST(CliEmbree, RendersAndReportsWhatItMeasured) {
   EXPECT_EQ(h["hit"]["object"]["kind"], "primitive");
   EXPECT_EQ(h["rays"]["primary"], 1);
   // Its EXR has every layer but the cost (Embree counts no tests), rather than a cost of zeros.
-  const std::string exr = (fs::temp_directory_path() / "amalgam-embree-cli.exr").string();
+  const std::string exr = (amalgam::test::scratch_dir("amalgam-embree-cli") / "out.exr").string();
   const CliResult e =
       run("render builtin:prisms --set depth=3 --width 16 --height 12 --spp 1 --tracer embree "
           "--renderer traditional --quiet --out " +

@@ -67,6 +67,25 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
   return j;
 }
 
+nlohmann::json trace_json(const LoadedScene& scene, const RenderOptions& o, const TraceOutput& t,
+                          double seconds, double embree_build_seconds) {
+  using nlohmann::json;
+  json j = stats_json(scene, o, t.counters, t.per_primary, seconds, embree_build_seconds);
+  if (t.hit.kind == TraceHit::Kind::kNone) {
+    j["hit"] = nullptr;
+  } else {
+    const bool embree = o.tracer == TracerKind::kEmbree;
+    j["hit"] = {{"t", t.hit.t},
+                {"object",
+                 {{"kind", t.hit.kind == TraceHit::Kind::kPrimitive ? "primitive" : "amalgam"},
+                  {"id", t.hit.id},
+                  {"level", embree ? json(nullptr) : json(t.hit.level)}}},
+                {"point", {t.hit.surf.p.x, t.hit.surf.p.y, t.hit.surf.p.z}}};
+  }
+  j["colour"] = {t.colour.x, t.colour.y, t.colour.z};
+  return j;
+}
+
 void add_run_info(nlohmann::json& j, const RunInfo& info) {
   j["width"] = info.width;
   j["height"] = info.height;

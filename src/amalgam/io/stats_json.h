@@ -11,6 +11,7 @@
 #include "amalgam/io/colormap.h"
 #include "amalgam/render/loaded_scene.h"
 #include "amalgam/render/options.h"
+#include "amalgam/render/render.h"
 #include "amalgam/stats/counters.h"
 #include "amalgam/stats/distribution.h"
 
@@ -24,6 +25,12 @@ namespace amalgam {
 nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& options,
                           const Counters& counters, const CostDistribution& per_primary,
                           double render_seconds, double embree_build_seconds = 0.0);
+
+/// The JSON of `amalgam trace` (and Python's Scene.trace): stats_json of the one ray plus
+/// "hit" (null, or t, object {kind, id, level} and point) and "colour". The level is null
+/// under --tracer embree (Embree knows no levels).
+nlohmann::json trace_json(const LoadedScene& scene, const RenderOptions& options,
+                          const TraceOutput& t, double seconds, double embree_build_seconds = 0.0);
 
 /// What a whole render adds to its stats object.
 struct RunInfo {
