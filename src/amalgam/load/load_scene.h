@@ -42,6 +42,10 @@ struct CameraChoice {
 /// vector along the view direction.
 void choose_camera(LoadedScene& scene, const CameraChoice& choice);
 
+/// The environment `choose_camera` would give the scene, leaving the scene as it is: another
+/// view of one built, baked scene (render's `env` overload, render/render.h). Same errors.
+Environment chosen_view(const LoadedScene& scene, const CameraChoice& choice);
+
 /// Loads `spec`. Throws InputError (one line naming the scene and the problem) on bad input,
 /// including a scene file or mesh that would take more than `config.max_bytes` (checked before
 /// building; the builtin scenes are implicit and take no memory to speak of).

@@ -80,6 +80,11 @@ struct RenderControl {
 RenderOutput render(const LoadedScene& scene, const RenderOptions& options,
                     FilmState* resume = nullptr, const RenderControl& control = {});
 
+/// The same with another view of the scene: `env` (camera, lights, background) replaces
+/// scene.env, the hierarchy and its bake are shared (e.g. `chosen_view`, load/load_scene.h).
+RenderOutput render(const LoadedScene& scene, const Environment& env, const RenderOptions& options,
+                    FilmState* resume = nullptr, const RenderControl& control = {});
+
 /// Prepares `st` for a render of `options`: a fresh film when it holds none, else checks that
 /// the saved one fits (InputError). Shared by `render` and `render_embree`.
 void start_film(FilmState& st, const RenderOptions& options);

@@ -8,11 +8,12 @@
 namespace amalgam::detail {
 
 /// Runs the pass loop of `render` (passes.h) with the integrator and traversal the options
-/// select; returns whether it was interrupted.
-bool render_passes_portable(const LoadedScene& scene, const RenderOptions& o, FilmState& st,
-                            const RenderControl& control);
-bool render_passes_avx2(const LoadedScene& scene, const RenderOptions& o, FilmState& st,
-                        const RenderControl& control);
+/// select, seen with `env` (the scene's or another view of it); returns whether it was
+/// interrupted.
+bool render_passes_portable(const LoadedScene& scene, const Environment& env,
+                            const RenderOptions& o, FilmState& st, const RenderControl& control);
+bool render_passes_avx2(const LoadedScene& scene, const Environment& env, const RenderOptions& o,
+                        FilmState& st, const RenderControl& control);
 
 /// Traces one primary sample along `ray` into `out` (counters, hit, colour).
 void trace_portable(const LoadedScene& scene, const RenderOptions& o, const Ray& ray,

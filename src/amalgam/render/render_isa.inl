@@ -37,13 +37,14 @@ AMALGAM_ISA_END
 
 namespace detail {
 
-bool AMALGAM_ISA_SUFFIXED(render_passes)(const LoadedScene& scene, const RenderOptions& o,
-                                         FilmState& st, const RenderControl& control) {
+bool AMALGAM_ISA_SUFFIXED(render_passes)(const LoadedScene& scene, const Environment& env,
+                                         const RenderOptions& o, FilmState& st,
+                                         const RenderControl& control) {
   bool interrupted = false;
   dispatch(scene, o, [&](const auto& h, auto lod, auto op, auto order) {
     using I = Integrator<std::decay_t<decltype(h)>, decltype(lod), decltype(op), decltype(order)>;
-    interrupted = render_passes(scene.env.camera, o, st, control,
-                                [&](Counters& c) { return I(h, scene.env, lod, c); });
+    interrupted =
+        render_passes(env.camera, o, st, control, [&](Counters& c) { return I(h, env, lod, c); });
   });
   return interrupted;
 }
