@@ -49,11 +49,13 @@ class Scene:
         order: str = "sorted",  # or "unsorted"
         seed: int = 0,
         threads: int = 0,  # 0: all cores
+        sampler: str = "independent",  # or "stratified"
         camera: Optional[Union[str, int]] = None,
         eye: Optional[Sequence[float]] = None,
         look_at: Optional[Sequence[float]] = None,
         up: Optional[Sequence[float]] = None,
         fov: Optional[float] = None,
+        light_samples: Optional[int] = None,
     ) -> RenderResult:
         """Renders the camera view (camera=, eye=, look_at=, up=, fov= change it for this
         render only, from the view `load` chose); KeyboardInterrupt carries `.partial`."""

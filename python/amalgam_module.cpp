@@ -64,14 +64,14 @@ struct Options {
 Options make_options(int width, int height, int spp, const std::string& renderer,
                      const std::string& opacity, std::optional<int> level,
                      std::optional<float> footprint, const std::string& order, std::uint64_t seed,
-                     int threads) {
+                     int threads, const std::string& sampler = "independent") {
   // The checks and messages of the CLI (apps/amalgam/common.cpp, CommonOptions::finish).
   if (renderer != "scale-sensitive" && renderer != "traditional")
     throw InputError("--renderer " + one_line(renderer, 40) +
                      ": expected scale-sensitive or traditional");
-  if (opacity != "stochastic" && opacity != "deterministic")
+  if (!parse_opacity(opacity))
     throw InputError("--opacity " + one_line(opacity, 40) +
-                     ": expected stochastic or deterministic");
+                     ": expected stochastic, deterministic or prefiltered");
   if (order != "sorted" && order != "unsorted")
     throw InputError("--order " + one_line(order, 40) + ": expected sorted or unsorted");
   if (level && footprint)
@@ -90,15 +90,18 @@ Options make_options(int width, int height, int spp, const std::string& renderer
   if (spp < 1) throw InputError("--spp " + std::to_string(spp) + ": expected an integer >= 1");
   if (threads < 0)
     throw InputError("--threads " + std::to_string(threads) + ": expected an integer >= 0");
+  if (sampler != "independent" && sampler != "stratified")
+    throw InputError("--sampler " + one_line(sampler, 40) + ": expected independent or stratified");
   Options r;
   r.o.renderer =
       renderer == "traditional" ? RendererKind::kTraditional : RendererKind::kScaleSensitive;
-  r.o.opacity = opacity == "deterministic" ? OpacityKind::kDeterministic : OpacityKind::kStochastic;
+  r.o.opacity = *parse_opacity(opacity);
   r.o.level = level;
   r.o.footprint = footprint ? *footprint : 1.0f;
   r.o.sorted = order == "sorted";
   r.o.seed = seed;
   r.o.threads = threads;
+  r.o.sampler = sampler == "stratified" ? PixelSampler::kStratified : PixelSampler::kIndependent;
   r.o.width = width;
   r.o.height = height;
   r.o.spp = spp;
@@ -183,6 +186,15 @@ bool view_keyword(const std::string& key, const py::handle& value, CameraChoice&
     view.look_at = view_vec(value, "--look-at");
   } else if (key == "up") {
     view.up = view_vec(value, "--up");
+  } else if (key == "light_samples") {
+    int n = 0;
+    try {
+      n = value.cast<int>();
+    } catch (const py::cast_error&) {
+      throw InputError("--light-samples " + one_line(py::str(value).cast<std::string>(), 40) +
+                       ": expected an integer in [1, 4096]");
+    }
+    view.light_samples = n;
   } else if (key == "fov") {
     const std::string text = py::str(value).cast<std::string>();
     double x = NAN;
@@ -210,16 +222,20 @@ struct Scene {
   std::shared_ptr<RenderResult> render(int width, int height, int spp, const std::string& renderer,
                                        const std::string& opacity, std::optional<int> level,
                                        std::optional<float> footprint, const std::string& order,
-                                       std::uint64_t seed, int threads, const py::object& camera,
+                                       std::uint64_t seed, int threads, const std::string& sampler,
+                                       const py::object& camera,
                                        const py::object& eye, const py::object& look_at,
-                                       const py::object& up, const py::object& fov) {
+                                       const py::object& up, const py::object& fov,
+                                       const py::object& light_samples) {
     const Options opt =
-        make_options(width, height, spp, renderer, opacity, level, footprint, order, seed, threads);
+        make_options(width, height, spp, renderer, opacity, level, footprint, order, seed, threads,
+                     sampler);
     check_options(*scene, opt.o);
     // Another view of the same built, baked scene: only the environment is new.
     CameraChoice view;
     const std::pair<const char*, const py::object*> keys[] = {
-        {"camera", &camera}, {"eye", &eye}, {"look_at", &look_at}, {"up", &up}, {"fov", &fov}};
+        {"camera", &camera}, {"eye", &eye},  {"look_at", &look_at},
+        {"up", &up},         {"fov", &fov}, {"light_samples", &light_samples}};
     for (const auto& [key, value] : keys)
       if (!value->is_none()) view_keyword(key, *value, view);
     auto env = std::make_shared<const Environment>(chosen_view(*scene, view));
@@ -450,12 +466,15 @@ PYBIND11_MODULE(amalgam, m) {
            py::arg("spp") = 4, py::arg("renderer") = "scale-sensitive",
            py::arg("opacity") = "stochastic", py::arg("level") = py::none(),
            py::arg("footprint") = py::none(), py::arg("order") = "sorted", py::arg("seed") = 0,
-           py::arg("threads") = 0, py::arg("camera") = py::none(), py::arg("eye") = py::none(),
+           py::arg("threads") = 0, py::arg("sampler") = "independent",
+           py::arg("camera") = py::none(), py::arg("eye") = py::none(),
            py::arg("look_at") = py::none(), py::arg("up") = py::none(), py::arg("fov") = py::none(),
+           py::arg("light_samples") = py::none(),
            "Renders the scene's camera view; the options are the CLI's (docs/cli.md). camera=\n"
            "(name or index), eye=, look_at=, up= (x, y, z) and fov= (degrees) change the view\n"
            "of this render only, as --camera, --eye, --look-at, --up and --fov do, starting from\n"
-           "the view `load` chose; the scene is not rebuilt or rebaked. The same\n"
+           "the view `load` chose; the scene is not rebuilt or rebaked. light_samples= is\n"
+           "--light-samples (shadow rays per sized light). The same\n"
            "seed gives the same image as `amalgam render ... --out x.pfm`, bit for bit, on any\n"
            "number of threads. The GIL is released. Ctrl-C (KeyboardInterrupt) stops the render\n"
            "at its next tile; the exception's `partial` attribute (and scene.last_result) holds\n"

@@ -1,6 +1,7 @@
 """Scene.render: bit-identity with the CLI's PFM, shapes, dtypes, stats, reuse, threads."""
 
 import json
+import pathlib
 import subprocess
 import threading
 
@@ -30,6 +31,9 @@ def read_pfm(path):
         (["--renderer", "traditional"], {"renderer": "traditional"}),
         (["--level", "4", "--opacity", "deterministic"], {"level": 4, "opacity": "deterministic"}),
         (["--footprint", "3", "--order", "unsorted"], {"footprint": 3.0, "order": "unsorted"}),
+        (["--opacity", "prefiltered", "--footprint", "2"],
+         {"opacity": "prefiltered", "footprint": 2.0}),
+        (["--sampler", "stratified"], {"sampler": "stratified"}),
     ],
 )
 def test_same_bits_as_cli_pfm(cli, demo, tmp_path, args, kwargs):
@@ -190,3 +194,18 @@ def test_camera_of_render_is_the_files_camera(cli, tmp_path):
     assert not np.array_equal(moved.image, r.image)
     with pytest.raises(ValueError, match="no such camera"):
         s.render(width=4, height=4, spp=1, camera="nope")
+
+
+def test_light_samples_as_cli(cli, tmp_path):
+    """--light-samples / light_samples= on a scene with a sized light (the soft field)."""
+    path = str(pathlib.Path(__file__).resolve().parents[2] / "scenes" / "field-soft.json")
+    out = tmp_path / "s.pfm"
+    subprocess.run([cli, "render", path, "--width", "16", "--height", "12", "--spp", "1",
+                    "--light-samples", "3", "--out", str(out)], check=True, capture_output=True)
+    s = amalgam.load(path)
+    r = s.render(width=16, height=12, spp=1, light_samples=3)
+    assert np.array_equal(r.image.view(np.uint32), read_pfm(out).view(np.uint32))
+    four = s.render(width=16, height=12, spp=1)  # the file's 4 samples
+    assert r.stats["rays"]["shadow"] < four.stats["rays"]["shadow"]
+    with pytest.raises(ValueError, match="--light-samples"):
+        s.render(width=4, height=4, spp=1, light_samples=0)

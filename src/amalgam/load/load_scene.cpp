@@ -126,9 +126,16 @@ Environment chosen_view(const LoadedScene& scene, const CameraChoice& choice) {
                        c.look_at != scene.env.camera.look_at || c.up != scene.env.camera.up ||
                        c.vfov_deg != scene.env.camera.vfov_deg;
   Environment env = scene.env;
+  if (choice.light_samples) {
+    if (!(*choice.light_samples >= 1 && *choice.light_samples <= 4096))
+      throw InputError("--light-samples " + std::to_string(*choice.light_samples) +
+                       ": expected an integer in [1, 4096]");
+    for (Light& l : env.lights)
+      if (l.sized()) l.samples = *choice.light_samples;
+  }
   if (!changed) return env;
   env.camera = c;
-  if (scene.default_lights) {
+  if (scene.default_lights) {  // (unsized: light_samples does not apply to them)
     const Bbox b = std::visit([](const auto& h) { return h.bounds(h.root()); }, scene.hierarchy);
     env.lights = default_lights(b, c);
   }
