@@ -351,9 +351,12 @@ py::list experiment(const std::string& name, bool quick, int threads) {
   if (threads < 0)
     throw InputError("--threads " + std::to_string(threads) + ": expected an integer >= 0");
   experiments::ExperimentResult r;
+  experiments::Config config;
+  config.quick = quick;
+  config.threads = threads;
   {
     py::gil_scoped_release nogil;
-    r = experiments::run(name, experiments::Config{quick, threads});
+    r = experiments::run(name, config);
   }
   py::list rows;
   for (const auto& row : r.table.rows) {

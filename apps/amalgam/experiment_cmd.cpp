@@ -2,6 +2,7 @@
 /// sweeps (amalgam/analysis/experiments.h) and writes DIR/<name>.csv, DIR/<name>.gp and
 /// DIR/<name>.png (gnuplot) and DIR/report.md.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -154,6 +155,45 @@ std::string section(const ex::ExperimentResult& r, bool plotted, bool gnuplot) {
   return o.str();
 }
 
+/// Every statement of the paper with the verdict its checks give (ex::verdict_of), computed
+/// from the checks of the experiments run; statements no experiment run checks say so.
+std::string statements_table(const std::vector<ex::Check>& checks,
+                             const std::vector<std::string>& ran) {
+  std::ostringstream o;
+  o << "Every equation and statement of the paper, in its order, with the verdict computed from "
+       "the checks that bear on it (holds: every check passes; holds with correction: the "
+       "printed form is refuted by a check and the corrected form passes; does not hold: a "
+       "check of the statement fails). Hand derivations of each: "
+       "`docs/paper-derivations.md` of the repository.\n\n";
+  o << "| statement | the paper says | verdict | checks passed | experiment |\n"
+       "|---|---|---|---|---|\n";
+  for (const ex::Statement& st : ex::statements()) {
+    int total = 0, passed = 0;
+    for (const auto& c : checks)
+      if (c.statement == st.id) ++total, passed += c.passed();
+    bool run = false;
+    for (const auto& e : st.experiments) run |= std::find(ran.begin(), ran.end(), e) != ran.end();
+    std::string verdict;
+    if (const auto v = ex::verdict_of(checks, st.id))
+      verdict = ex::to_string(*v);
+    else if (st.experiments.empty())
+      verdict = "not measured (derived by hand only)";
+    else
+      verdict = run ? "no check" : "not run";
+    o << "| " << st.id << " | " << st.says << " | " << verdict << " | ";
+    if (total > 0)
+      o << passed << "/" << total;
+    else
+      o << "-";
+    o << " | ";
+    if (st.experiments.empty()) o << "-";
+    for (std::size_t i = 0; i < st.experiments.size(); ++i)
+      o << (i ? ", " : "") << "[" << st.experiments[i] << "](#" << st.experiments[i] << ")";
+    o << " |\n";
+  }
+  return o.str();
+}
+
 }  // namespace
 
 int run_experiment(const std::string& name, const std::string& out_dir, bool quick, int threads) {
@@ -187,8 +227,10 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
          << "through the renderer (builtin:line, builtin:poisson, builtin:prisms), except the "
          << "2D searches of linear-cost; predictions come from `src/amalgam/analysis/formulas.h`."
          << (gnuplot ? "" : " **gnuplot was not found on PATH: no plots were made.**") << "\n\n";
-  report << "| experiment | verdict | checks passed | seconds |\n|---|---|---|---|\n";
-  std::ostringstream body;
+  std::ostringstream summary, body;
+  summary << "| experiment | verdict | checks passed | seconds |\n|---|---|---|---|\n";
+  std::vector<ex::Check> all_checks;  // of every experiment run, for the statements table
+  std::vector<std::string> ran;
   int failures = 0;
   for (const std::string& n : todo) {
     std::cerr << "amalgam: experiment " << n << " ..." << std::flush;
@@ -203,11 +245,13 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
               << " checks, " << ex::fmt(r.seconds) << " s\n";
     std::cout << n << ": " << ex::to_string(r.verdict) << " (" << passed << "/" << r.checks.size()
               << " checks)\n";
-    report << "| [" << n << "](#" << n << ") | " << ex::to_string(r.verdict) << " | " << passed
-           << "/" << r.checks.size() << " | " << ex::fmt(r.seconds) << " |\n";
+    summary << "| [" << n << "](#" << n << ") | " << ex::to_string(r.verdict) << " | " << passed
+            << "/" << r.checks.size() << " | " << ex::fmt(r.seconds) << " |\n";
     body << section(r, plotted, gnuplot);
+    all_checks.insert(all_checks.end(), r.checks.begin(), r.checks.end());
+    ran.push_back(n);
   }
-  report << "\n" << body.str();
+  report << statements_table(all_checks, ran) << "\n" << summary.str() << "\n" << body.str();
   write_file_atomic((dir / "report.md").string(), report.str());
   std::cout << "report: " << (dir / "report.md").string() << "\n";
   (void)failures;

@@ -208,6 +208,85 @@ TEST(Experiments, LinearCostSeparatesLogFromNonLog) {
   EXPECT_LT(r.table.at(last, "pt2d_tile") * 2, r.table.at(last, "ray2d_tile"));
 }
 
+// The verdict rule itself: a failing supporting check means "does not hold"; a passing check
+// that refutes a printed form means "holds with correction"; otherwise "holds".
+TEST(Experiments, VerdictFollowsFromTheChecks) {
+  const Check ok("agrees", 1, 1, 0), bad("disagrees", 1, 2, 0.5);
+  const Check refuted("printed is off", 1, 1, 0, Role::kRefutesPrinted, "Eq. X");
+  const Check not_refuted("printed is off", 1, 2, 0, Role::kRefutesPrinted, "Eq. X");
+  EXPECT_EQ(verdict_of({ok}), Verdict::kHolds);
+  EXPECT_EQ(verdict_of({ok, not_refuted}), Verdict::kHolds);
+  EXPECT_EQ(verdict_of({ok, refuted}), Verdict::kHoldsWithCorrection);
+  EXPECT_EQ(verdict_of({ok, refuted, bad}), Verdict::kDoesNotHold);
+  EXPECT_EQ(verdict_of({ok, refuted}, "Eq. X"), Verdict::kHoldsWithCorrection);
+  EXPECT_EQ(verdict_of({ok}, "Eq. X"), std::nullopt);
+}
+
+// Verdicts are computed, not written: a deliberately wrong formula injected through
+// Config::perturb makes the checks that use it fail and turns the verdict, and the report's
+// words follow.
+TEST(Experiments, AWrongFormulaTurnsTheVerdict) {
+  Config c;
+  c.quick = true;
+  c.threads = 2;
+  EXPECT_EQ(run("worst-traditional", c).verdict, Verdict::kHolds);
+  EXPECT_EQ(run("expected", c).verdict, Verdict::kHoldsWithCorrection);
+
+  Config off_by_one = c;  // C_t0 one test too many
+  off_by_one.perturb = [](const std::string& f, double v) { return f == "c_t0" ? v + 1 : v; };
+  const ExperimentResult t = run("worst-traditional", off_by_one);
+  EXPECT_EQ(t.verdict, Verdict::kDoesNotHold);
+  EXPECT_EQ(verdict_of(t.checks, "C_t0"), Verdict::kDoesNotHold);
+
+  // Were the printed Eq. 12 limit (1 - e^-n) the true one, nothing would refute it: the
+  // experiment would hold without correction...
+  const double correct = 1 / (1 - std::exp(-2.0)), printed = 1 - std::exp(-2.0);
+  Config printed_right = c;
+  printed_right.perturb = [&](const std::string& f, double v) {
+    return f == "eq12_limit" ? correct : v;
+  };
+  const ExperimentResult e1 = run("expected", printed_right);
+  EXPECT_EQ(verdict_of(e1.checks, "Eq. 12"), Verdict::kHolds);
+  EXPECT_EQ(e1.verdict, Verdict::kHolds);
+  EXPECT_NE(e1.findings.find("Eq. 12 as printed was not refuted"), std::string::npos);
+  // ... and were our correction wrong, the statement would not hold.
+  Config correction_wrong = c;
+  correction_wrong.perturb = [&](const std::string& f, double v) {
+    return f == "eq12_correct_limit" ? printed : v;
+  };
+  const ExperimentResult e2 = run("expected", correction_wrong);
+  EXPECT_EQ(verdict_of(e2.checks, "Eq. 12"), Verdict::kDoesNotHold);
+  EXPECT_EQ(e2.verdict, Verdict::kDoesNotHold);
+  EXPECT_EQ(e2.findings.find("Eq. 12 is wrong as printed"), std::string::npos);
+
+  // A wrong E[i] (Eq. 9's quantity 5% too high) breaks Eqs. 9, 10 and 13 at once.
+  Config eq9_wrong = c;
+  eq9_wrong.perturb = [](const std::string& f, double v) {
+    return f == "expected_visits_exact" ? 1.05 * v : v;
+  };
+  const ExperimentResult e3 = run("expected", eq9_wrong);
+  EXPECT_EQ(verdict_of(e3.checks, "Eq. 10"), Verdict::kDoesNotHold);
+  EXPECT_EQ(e3.verdict, Verdict::kDoesNotHold);
+  EXPECT_NE(e3.findings.find("do not all hold"), std::string::npos);
+}
+
+// Every check names a statement of statements(), and that statement names the experiment.
+TEST(Experiments, EveryCheckBearsOnAListedStatement) {
+  std::set<std::string> ids;
+  for (const Statement& st : statements()) EXPECT_TRUE(ids.insert(st.id).second) << st.id;
+  for (const std::string& name : names()) {
+    const ExperimentResult r = quick(name);
+    for (const Check& c : r.checks) {
+      SCOPED_TRACE(name + ": " + c.what);
+      const auto it = std::find_if(statements().begin(), statements().end(),
+                                   [&](const Statement& s) { return s.id == c.statement; });
+      ASSERT_NE(it, statements().end()) << "unknown statement '" << c.statement << "'";
+      EXPECT_NE(std::find(it->experiments.begin(), it->experiments.end(), name),
+                it->experiments.end());
+    }
+  }
+}
+
 TEST(Experiments, FitLineRecoversALine) {
   const LinearFit f = fit_line({0, 1, 2, 3}, {1, 3, 5, 7});
   EXPECT_DOUBLE_EQ(f.a, 1);

@@ -30,6 +30,27 @@ const char* to_string(Verdict v) {
   return "?";
 }
 
+Verdict verdict_of(const std::vector<Check>& checks) {
+  bool corrected = false;
+  for (const Check& c : checks) {
+    if (c.role == Role::kSupports && !c.passed()) return Verdict::kDoesNotHold;
+    if (c.role == Role::kRefutesPrinted && c.passed()) corrected = true;
+  }
+  return corrected ? Verdict::kHoldsWithCorrection : Verdict::kHolds;
+}
+
+std::optional<Verdict> verdict_of(const std::vector<Check>& checks, const std::string& id) {
+  std::vector<Check> mine;
+  for (const Check& c : checks)
+    if (c.statement == id) mine.push_back(c);
+  if (mine.empty()) return std::nullopt;
+  return verdict_of(mine);
+}
+
+double predict(const Config& config, const std::string& name, double value) {
+  return config.perturb ? config.perturb(name, value) : value;
+}
+
 const std::vector<std::string>& names() {
   static const std::vector<std::string> n = {"worst-traditional",
                                              "worst-stochastic",
@@ -60,6 +81,7 @@ ExperimentResult run(const std::string& name, const Config& config) {
     const auto t0 = std::chrono::steady_clock::now();
     ExperimentResult r = f(config);
     r.name = name;
+    r.verdict = verdict_of(r.checks);
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return r;
   }

@@ -72,7 +72,7 @@ ExperimentResult more_levels(const Config& c) {
                       true,
                       {{"k", "ss_seconds", "scale-sensitive, level 3", false},
                        {"k", "trad_seconds", "traditional", false}}});
-  r.verdict = Verdict::kHolds;
+  tag(r, "More levels");
   r.findings = "From k = 0 to k = " + str(K) + " (primitives " + fmt(first[2]) + " -> " +
                fmt(last[2]) + "), the scale-sensitive render made exactly the same " +
                fmt(first[3]) + " tests and an identical image (max pixel difference " +
