@@ -140,6 +140,7 @@ ExperimentResult worst_traditional(const Config& c);
 ExperimentResult worst_stochastic(const Config& c);
 ExperimentResult worst_deterministic(const Config& c);
 ExperimentResult expected(const Config& c);
+ExperimentResult traversed(const Config& c);
 ExperimentResult failed_tests(const Config& c);
 ExperimentResult lights(const Config& c);
 ExperimentResult noise(const Config& c);

@@ -40,12 +40,12 @@ const std::vector<Statement>& statements() {
       {"Eq. 4",
        "a traversal through i amalgams of level l1 costs at least l1 + i "
        "(objects traversed)",
-       {"expected"}},
-      {"Eqs. 5-7", "C_b = n/(n - 1), independent of l1; i C_b for large i", {}},
+       {"traversed"}},
+      {"Eqs. 5-7", "C_b = n/(n - 1), independent of l1; i C_b for large i", {"traversed"}},
       {"Eq. 8",
        "the cost of a traversal through i amalgams is max(log_n b + i, i C_b) "
        "(objects traversed)",
-       {"expected"}},
+       {"traversed"}},
       {"Eq. 9", "E[i] under the Poisson model (closed form)", {"expected"}},
       {"Eq. 10", "Eq. 9 with p/b = n (traditional renderer)", {"expected"}},
       {"Eq. 11", "a e^{-cp} + k -> k for large p", {}},
