@@ -61,7 +61,8 @@ const std::vector<std::string>& names() {
                                              "lights",
                                              "noise",
                                              "more-levels",
-                                             "linear-cost"};
+                                             "linear-cost",
+                                             "p-vs-P"};
   return n;
 }
 
@@ -77,7 +78,8 @@ ExperimentResult run(const std::string& name, const Config& config) {
       {"lights", lights},
       {"noise", noise},
       {"more-levels", more_levels},
-      {"linear-cost", linear_cost}};
+      {"linear-cost", linear_cost},
+      {"p-vs-P", p_vs_primitives}};
   for (const auto& [n, f] : table) {
     if (n != name) continue;
     const auto t0 = std::chrono::steady_clock::now();

@@ -146,6 +146,7 @@ ExperimentResult lights(const Config& c);
 ExperimentResult noise(const Config& c);
 ExperimentResult more_levels(const Config& c);
 ExperimentResult linear_cost(const Config& c);
+ExperimentResult p_vs_primitives(const Config& c);
 
 /// Least-squares fit y = a + b x; returns {a, b, r^2}.
 struct LinearFit {
