@@ -308,6 +308,14 @@ TEST(Experiments, FitLineRecoversALine) {
   EXPECT_DOUBLE_EQ(f.a, 1);
   EXPECT_DOUBLE_EQ(f.b, 2);
   EXPECT_NEAR(f.r2, 1, 1e-12);
+  EXPECT_NEAR(f.ci95_b, 0, 1e-12) << "an exact line has no slope uncertainty";
+  // y = (-1, 2, 1, 4) at x = 0..3: sxx = 5, sxy = 7, syy = 13, slope 1.4; residual sum of
+  // squares 13 - 1.4 * 7 = 3.2 over 2 degrees of freedom, so se = sqrt(1.6 / 5) and the 95%
+  // half-width is t(0.975, 2) = 4.303 times that.
+  const LinearFit g = fit_line({0, 1, 2, 3}, {-1, 2, 1, 4});
+  EXPECT_NEAR(g.b, 1.4, 1e-12);
+  EXPECT_NEAR(g.se_b, std::sqrt(0.32), 1e-12);
+  EXPECT_NEAR(g.ci95_b, 4.303 * std::sqrt(0.32), 1e-12);
 }
 
 }  // namespace

@@ -148,9 +148,11 @@ ExperimentResult more_levels(const Config& c);
 ExperimentResult linear_cost(const Config& c);
 ExperimentResult p_vs_primitives(const Config& c);
 
-/// Least-squares fit y = a + b x; returns {a, b, r^2}.
+/// Least-squares fit y = a + b x; returns {a, b, r^2} and the slope's standard error and
+/// 95% confidence half-width (Student t with n - 2 degrees of freedom; 0 for n < 3).
 struct LinearFit {
   double a = 0, b = 0, r2 = 0;
+  double se_b = 0, ci95_b = 0;
 };
 LinearFit fit_line(const std::vector<double>& x, const std::vector<double>& y);
 

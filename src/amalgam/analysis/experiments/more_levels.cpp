@@ -57,6 +57,18 @@ ExperimentResult more_levels(const Config& c) {
   const auto& last = r.table.rows.back();
   r.checks.push_back({"traditional tests grow with k (last/first > 2)",
                       std::min(last[5] / first[5], 2.0), 2.0, 0});
+  // Wall time per ray against k: slope with its 95% confidence interval (reported, not
+  // checked: timings depend on the machine and its load).
+  std::vector<double> ks, ss_us, tr_us;
+  const double rays_per_render = double(size) * size;
+  for (const auto& row : r.table.rows) {
+    ks.push_back(row[0]);
+    ss_us.push_back(row[4] * 1e6 / rays_per_render);
+    tr_us.push_back(row[6] * 1e6 / rays_per_render);
+  }
+  const LinearFit sf = fit_line(ks, ss_us), tf = fit_line(ks, tr_us);
+  double ss_mean = 0;
+  for (double v : ss_us) ss_mean += v / double(ss_us.size());
   r.summary_columns = r.table.columns;
   r.panels.push_back({"Tests per primary ray vs added levels k (prisms corner, l1=3)",
                       "k (levels added below l1)",
@@ -80,7 +92,17 @@ ExperimentResult more_levels(const Config& c) {
                " s. The traditional render grew from " + fmt(first[9]) + " to " + fmt(last[9]) +
                " tests per ray (time " + fmt(first[6]) + " s -> " + fmt(last[6]) +
                " s): it grows with every added level (roughly linearly in k here, because the "
-               "first hit is found early in this dense scene: the expected case, O(log p)).";
+               "first hit is found early in this dense scene: the expected case, O(log p)).\n\n"
+               "Wall time per primary ray (" +
+               str(size) + "^2 pixels, 1 spp, " + str(int(ks.size())) +
+               " values of k), fitted against k: scale-sensitive " + fmt(sf.b) + " +- " +
+               fmt(sf.ci95_b) + " us per added level (95% CI; mean " + fmt(ss_mean) +
+               " us per ray" +
+               (std::fabs(sf.b) <= sf.ci95_b ? ", the interval contains 0: flat"
+                                             : ", the interval excludes 0") +
+               "); traditional " + fmt(tf.b) + " +- " + fmt(tf.ci95_b) +
+               " us per added level. Reported, not checked: timings depend on the machine and "
+               "its load.";
   return r;
 }
 
