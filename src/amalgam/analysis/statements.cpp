@@ -54,6 +54,12 @@ const std::vector<Statement>& statements() {
       {"O(log p) / O(log b)",
        "expected cost: O(log p) traditional, O(log b) scale-sensitive",
        {"expected"}},
+      {"Secondary rays (expected)",
+       "expected times for secondary rays have the same asymptotic behaviour",
+       {"expected"}},
+      {"Failed tests (expected)",
+       "failed tests scale the cost; the expected-case asymptotics stay valid",
+       {"more-levels"}},
       {"Second Look sum",
        "failed tests: n^0 + sum_{i=1}^{l1} (n^{l1} + m n^{l1-1}) = "
        "1 + (1 + m/n) sum n^{l1} = O(n^{l1})",
