@@ -354,6 +354,7 @@ py::list experiment(const std::string& name, bool quick, int threads) {
   experiments::Config config;
   config.quick = quick;
   config.threads = threads;
+  config.load = [](const std::string& path) { return load_scene(path, Params(path)); };
   {
     py::gil_scoped_release nogil;
     r = experiments::run(name, config);

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "amalgam/analysis/experiments.h"
+#include "amalgam/load/load_scene.h"
 #include "amalgam/util/atomic_file.h"
 #include "common.h"
 
@@ -219,6 +220,7 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
   ex::Config config;
   config.quick = quick;
   config.threads = threads;
+  config.load = [](const std::string& path) { return load_scene(path, Params(path)); };
 
   std::ostringstream report;
   report << "# Thompson & Fussell (1991), \"Time Costs of Ray Tracing with Amalgams\": measured\n\n"

@@ -27,11 +27,14 @@ const char* to_string(Verdict v) {
       return "holds with correction";
     case Verdict::kDoesNotHold:
       return "does not hold";
+    case Verdict::kNotMeasured:
+      return "not measured";
   }
   return "?";
 }
 
 Verdict verdict_of(const std::vector<Check>& checks) {
+  if (checks.empty()) return Verdict::kNotMeasured;
   bool corrected = false;
   for (const Check& c : checks) {
     if (c.role == Role::kSupports && !c.passed()) return Verdict::kDoesNotHold;
@@ -61,6 +64,7 @@ const std::vector<std::string>& names() {
                                              "failed-tests",
                                              "lights",
                                              "noise",
+                                             "noise-baked",
                                              "more-levels",
                                              "linear-cost",
                                              "p-vs-P"};
@@ -78,6 +82,7 @@ ExperimentResult run(const std::string& name, const Config& config) {
       {"failed-tests", failed_tests},
       {"lights", lights},
       {"noise", noise},
+      {"noise-baked", noise_baked},
       {"more-levels", more_levels},
       {"linear-cost", linear_cost},
       {"p-vs-P", p_vs_primitives}};

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "amalgam/render/loaded_scene.h"
+
 namespace amalgam::experiments {
 
 /// A numeric table: the CSV of one experiment.
@@ -79,11 +81,13 @@ struct Check {
   bool passed() const;
 };
 
-enum class Verdict { kHolds, kHoldsWithCorrection, kDoesNotHold };
+/// kNotMeasured: no check was made (e.g. the scenes an experiment needs could not be loaded).
+enum class Verdict { kHolds, kHoldsWithCorrection, kDoesNotHold, kNotMeasured };
 const char* to_string(Verdict v);
 
-/// The verdict that follows from checks (never written by hand): does not hold if a kSupports
-/// check fails; else holds with correction if a kRefutesPrinted check passes; else holds.
+/// The verdict that follows from checks (never written by hand): not measured if there are
+/// none; does not hold if a kSupports check fails; else holds with correction if a
+/// kRefutesPrinted check passes; else holds.
 Verdict verdict_of(const std::vector<Check>& checks);
 
 /// The verdict of the checks bearing on one paper statement (Check::statement == id), or
@@ -123,6 +127,9 @@ struct Config {
   /// perturb(formula name, value) (see predict()); a deliberately wrong formula injected here
   /// must turn the verdict (tests/analysis/experiments_test.cpp). Empty: predictions as computed.
   std::function<double(const std::string& formula, double value)> perturb;
+  /// Loads a scene file or mesh (the analysis layer cannot: load/ sits above it). Set by the
+  /// CLI and the tests; empty: experiments that need files report them as not measured.
+  std::function<LoadedScene(const std::string& path)> load;
 };
 
 /// The prediction `value` of formula `name` as the experiment uses it: value itself, or
@@ -144,6 +151,7 @@ ExperimentResult traversed(const Config& c);
 ExperimentResult failed_tests(const Config& c);
 ExperimentResult lights(const Config& c);
 ExperimentResult noise(const Config& c);
+ExperimentResult noise_baked(const Config& c);
 ExperimentResult more_levels(const Config& c);
 ExperimentResult linear_cost(const Config& c);
 ExperimentResult p_vs_primitives(const Config& c);

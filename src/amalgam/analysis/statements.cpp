@@ -72,7 +72,7 @@ const std::vector<Statement>& statements() {
       {"Noise",
        "stochastic amalgams have lower image variance than the bounding volumes they "
        "replace, and stay cheaper after the extra sampling",
-       {"noise"}},
+       {"noise", "noise-baked"}},
   };
   return s;
 }

@@ -200,7 +200,8 @@ ExperimentResult noise(const Config& c) {
              "cheaper samples. ") +
       "This scene sets every amalgam's opacity to exactly its geometric coverage (fill^2), so "
       "it cannot show the mechanism at its best; scenes whose amalgams are baked from their "
-      "contents (a mesh, the field) are not measured here yet. Note that the two renderers "
+      "contents (a mesh, the field) are measured in [noise-baked](#noise-baked). Note that the two "
+      "renderers "
       "converge to different images (the amalgams' appearance is an average), so this compares "
       "noise, not error.";
   return r;
