@@ -180,7 +180,7 @@ std::string statements_table(const std::vector<ex::Check>& checks,
     else if (st.experiments.empty())
       verdict = "not measured (derived by hand only)";
     else
-      verdict = run ? "no check" : "not run";
+      verdict = run ? "measured, not checked (see the experiment)" : "not run";
     o << "| " << st.id << " | " << st.says << " | " << verdict << " | ";
     if (total > 0)
       o << passed << "/" << total;

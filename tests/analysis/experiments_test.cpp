@@ -79,7 +79,7 @@ void expect_checks_pass(const ExperimentResult& r) {
 }
 
 TEST(Experiments, NamesAreTheNineOfIssue3AndTraversed) {
-  EXPECT_EQ(names().size(), 12u);
+  EXPECT_EQ(names().size(), 13u);
   EXPECT_THROW(run("no-such-experiment", Config{}), std::invalid_argument);
 }
 
@@ -241,6 +241,22 @@ TEST(Experiments, NoiseBakedComparesEveryLevel) {
   EXPECT_GT(cheaper, 0);
   EXPECT_GT(dearer, 0);
   EXPECT_EQ(r.verdict, Verdict::kDoesNotHold);
+}
+
+// The premise experiment renders builtin and baked scenes both ways; its only checks are the
+// deterministic ones (the scale-sensitive renderer never makes more tests), wall-time fits are
+// reported, not checked.
+TEST(Experiments, PremiseRendersEveryScene) {
+  const ExperimentResult r = quick("premise");
+  expect_checks_pass(r);
+  std::set<double> scenes;
+  for (std::size_t i = 0; i < r.table.rows.size(); ++i) {
+    scenes.insert(r.table.at(i, "scene"));
+    EXPECT_LE(r.table.at(i, "tests_vs_trad"), 1.0) << "row " << i;
+    EXPECT_GT(r.table.at(i, "seconds"), 0.0);
+  }
+  EXPECT_EQ(scenes.size(), 4u) << "two builtin views, the Wuson mesh and the field";
+  for (const Check& c : r.checks) EXPECT_EQ(c.statement, "No slower") << c.what;
 }
 
 TEST(Experiments, LinearCostSeparatesLogFromNonLog) {

@@ -67,7 +67,8 @@ const std::vector<std::string>& names() {
                                              "noise-baked",
                                              "more-levels",
                                              "linear-cost",
-                                             "p-vs-P"};
+                                             "p-vs-P",
+                                             "premise"};
   return n;
 }
 
@@ -85,7 +86,8 @@ ExperimentResult run(const std::string& name, const Config& config) {
       {"noise-baked", noise_baked},
       {"more-levels", more_levels},
       {"linear-cost", linear_cost},
-      {"p-vs-P", p_vs_primitives}};
+      {"p-vs-P", p_vs_primitives},
+      {"premise", premise}};
   for (const auto& [n, f] : table) {
     if (n != name) continue;
     const auto t0 = std::chrono::steady_clock::now();

@@ -155,6 +155,7 @@ ExperimentResult noise_baked(const Config& c);
 ExperimentResult more_levels(const Config& c);
 ExperimentResult linear_cost(const Config& c);
 ExperimentResult p_vs_primitives(const Config& c);
+ExperimentResult premise(const Config& c);
 
 /// Least-squares fit y = a + b x; returns {a, b, r^2} and the slope's standard error and
 /// 95% confidence half-width (Student t with n - 2 degrees of freedom; 0 for n < 3).

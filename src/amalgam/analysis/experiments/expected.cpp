@@ -281,7 +281,11 @@ ExperimentResult expected(const Config& c) {
   r.findings =
       "Measured over " + str(rays) +
       " rays per point (traditional: a new Poisson realisation per ray; scale-sensitive: a new "
-      "stochastic-opacity seed per ray).\n\n" +
+      "stochastic-opacity seed per ray). The Poisson model makes each amalgam pass the ray "
+      "with probability e^{-p/b} independently of all others: uncorrelated, exponential "
+      "transmittance along the ray, as in a homogeneous medium. builtin:poisson is built to "
+      "follow it; real scenes are correlated (a wall stops every ray that reaches it, an empty "
+      "region passes them all), so there Eq. 9 is a model, not a prediction.\n\n" +
       std::string(eq9_holds ? "* **Eq. 9, 10, 13 hold** "
                             : "* **Eq. 9, 10, 13 do not all hold (see the failed checks)** ") +
       "(they are algebraically the truncated-geometric mean "
