@@ -123,6 +123,7 @@ ExperimentResult expected(const Config& c) {
   };
 
   LinearFit shadow_trad, shadow_ss;
+  std::string shadow_outliers;
   std::vector<double> shadow;  // mean shadow-ray tests per primary ray, one per row
   // Sweep 0: traditional renderer, l1 = l_max - 1, p = n^l_max (p/b = n).
   const int max_lmax = c.quick ? 10 : 20;
@@ -188,7 +189,12 @@ ExperimentResult expected(const Config& c) {
   {
     std::vector<double> x0, y0, x1, y1;
     for (const auto& row : r.table.rows) {
-      if (row[0] == 0) x0.push_back(row[18]), y0.push_back(row.back());
+      // l_max = 20 is left out: there the hit lies about 2^20 from the origin and the shadow
+      // ray, started a single-precision offset off the hit point, often tests only the root box
+      // (1 test on the ray of seed 3) -- a limit of this scene in float, reported below.
+      if (row[0] == 0 && row[3] <= 19) x0.push_back(row[18]), y0.push_back(row.back());
+      if (row[0] == 0 && row[3] > 19)
+        shadow_outliers += "l_max = " + fmt(row[3]) + ": " + fmt(row.back()) + " tests; ";
       if (row[0] == 1 && row[4] >= 64) x1.push_back(row[18]), y1.push_back(row.back());
     }
     shadow_trad = fit_line(x0, y0);
@@ -319,7 +325,14 @@ ExperimentResult expected(const Config& c) {
       fmt(shadow_trad.b) + " (r^2 = " + fmt(shadow_trad.r2) +
       ") for the traditional renderer and is flat in p for the scale-sensitive one (slope " +
       fmt(shadow_ss.b) +
-      " tests per doubling of p): the same asymptotics as the primary ray, as the paper says.";
+      " tests per doubling of p): the same asymptotics as the primary ray, as the paper says." +
+      (shadow_outliers.empty()
+           ? std::string()
+           : " Left out of the fit: " + shadow_outliers +
+                 "at l_max = 20 the hit lies about 2^20 from the origin and the shadow ray, "
+                 "started a single-precision offset off the hit point, often tests only the root "
+                 "box: "
+                 "a limit of builtin:poisson in float at that depth, not of the model.");
   return r;
 }
 

@@ -207,6 +207,7 @@ ExperimentResult premise(const Config& c) {
   r.summary_columns = {"scene",         "config",       "level",        "seconds",
                        "tests",         "fit_tests",    "fit_kinds",    "err_tests_pct",
                        "err_kinds_pct", "time_vs_trad", "tests_vs_trad"};
+  for (std::size_t i = 0; i < r.table.rows.size(); ++i) r.summary_rows.push_back(i);
   r.panels.push_back({"Render time against intersection tests",
                       "intersection tests (all rays)",
                       "seconds (" + str(size) + "^2 px, 1 spp, best of " + str(reps) + ")",
