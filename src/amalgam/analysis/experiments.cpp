@@ -28,7 +28,7 @@ const char* to_string(Verdict v) {
     case Verdict::kDoesNotHold:
       return "does not hold";
     case Verdict::kNotMeasured:
-      return "not measured";
+      return "not checked";
   }
   return "?";
 }
@@ -68,6 +68,7 @@ const std::vector<std::string>& names() {
                                              "more-levels",
                                              "linear-cost",
                                              "p-vs-P",
+                                             "sorting",
                                              "premise"};
   return n;
 }
@@ -87,6 +88,7 @@ ExperimentResult run(const std::string& name, const Config& config) {
       {"more-levels", more_levels},
       {"linear-cost", linear_cost},
       {"p-vs-P", p_vs_primitives},
+      {"sorting", sorting},
       {"premise", premise}};
   for (const auto& [n, f] : table) {
     if (n != name) continue;

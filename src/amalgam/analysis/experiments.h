@@ -81,7 +81,8 @@ struct Check {
   bool passed() const;
 };
 
-/// kNotMeasured: no check was made (e.g. the scenes an experiment needs could not be loaded).
+/// kNotMeasured ("not checked"): no check was made (a claim about wall time only, or the scenes
+/// an experiment needs could not be loaded).
 enum class Verdict { kHolds, kHoldsWithCorrection, kDoesNotHold, kNotMeasured };
 const char* to_string(Verdict v);
 
@@ -156,6 +157,7 @@ ExperimentResult more_levels(const Config& c);
 ExperimentResult linear_cost(const Config& c);
 ExperimentResult p_vs_primitives(const Config& c);
 ExperimentResult premise(const Config& c);
+ExperimentResult sorting(const Config& c);
 
 /// Least-squares fit y = a + b x; returns {a, b, r^2} and the slope's standard error and
 /// 95% confidence half-width (Student t with n - 2 degrees of freedom; 0 for n < 3).

@@ -36,7 +36,7 @@ const std::vector<Statement>& statements() {
        "added levels below l1 leave the scale-sensitive time unchanged; the "
        "traditional renderer takes longer",
        {"more-levels"}},
-      {"Sorting", "sorting children costs little (bucket sort, linear in n)", {}},
+      {"Sorting", "sorting children costs little (bucket sort, linear in n)", {"sorting"}},
       {"Eq. 4",
        "a traversal through i amalgams of level l1 costs at least l1 + i "
        "(objects traversed)",
