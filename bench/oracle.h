@@ -40,6 +40,7 @@ namespace amalgam {
 /// renders stops the ray.
 struct StopAtEveryAmalgam {
   static constexpr bool kBlends = false;
+  static constexpr bool kSaturates = false;
   AmalgamEffect effect(float, std::uint64_t, NodeId, bool) const { return AmalgamEffect::kStop; }
 };
 

@@ -340,7 +340,7 @@ int run(int argc, char** argv) {
   app.add_option("--spps", a.spps, "samples per pixel of the curves");
   app.add_option("--footprints", a.ks, "footprints K of the scale-sensitive curves");
   app.add_option("--opacity", a.opacity, "opacity model of the scale-sensitive curves")
-      ->check(CLI::IsMember({"stochastic", "deterministic", "prefiltered"}));
+      ->check(CLI::IsMember({"stochastic", "deterministic", "prefiltered", "composite"}));
   app.add_option("--light-samples", a.light_samples,
                  "shadow rays per sized light in every measured curve (default: the scene's; "
                  "the reference keeps the scene's)")

@@ -71,7 +71,7 @@ Options make_options(int width, int height, int spp, const std::string& renderer
                      ": expected scale-sensitive or traditional");
   if (!parse_opacity(opacity))
     throw InputError("--opacity " + one_line(opacity, 40) +
-                     ": expected stochastic, deterministic or prefiltered");
+                     ": expected stochastic, deterministic, prefiltered or composite");
   if (order != "sorted" && order != "unsorted")
     throw InputError("--order " + one_line(order, 40) + ": expected sorted or unsorted");
   if (level && footprint)

@@ -17,9 +17,10 @@ void CommonOptions::add_to(CLI::App& app) {
           ->check(CLI::IsMember({"scale-sensitive", "traditional"}));
   opacity_option =
       app.add_option("--opacity", opacity,
-                     "stochastic (default), deterministic, or prefiltered (stochastic for camera "
-                     "rays, deterministic for shadow rays)")
-          ->check(CLI::IsMember({"stochastic", "deterministic", "prefiltered"}));
+                     "stochastic (default), deterministic, prefiltered (stochastic for camera "
+                     "rays, deterministic for shadow rays) or composite (deterministic for all, "
+                     "one shadow computation per camera ray)")
+          ->check(CLI::IsMember({"stochastic", "deterministic", "prefiltered", "composite"}));
   level_option =
       app.add_option("--level", level, "scale-sensitive: render the amalgams met on level L")
           ->check(non_negative_int());

@@ -22,7 +22,8 @@ namespace {
 LoadedScene floor_scene(const std::string& light, const std::string& extra = "") {
   SceneDescription d = parse_scene_json(
       R"({"camera": {"position": [0, 6, 0.01], "look_at": [0, 0, 0], "vfov": 60},
-          "lights": [)" + light + R"(],
+          "lights": [)" +
+          light + R"(],
           "background": [0, 0, 0],
           "materials": {"m": {"colour": [0.8, 0.8, 0.8]}},
           "triangles": [{"vertices": [[-20, 0, -20], [20, 0, -20], [20, 0, 20]], "material": "m"},
@@ -105,7 +106,7 @@ TEST(SizedLights, ASizedLightCastsAPenumbraAPointLightDoesNot) {
       R"({"type": "point", "position": [0, 4, 0], "intensity": [20, 20, 20], "radius": 0.8,
           "samples": 32})");
   EXPECT_GT(point_dark, 0);
-  EXPECT_GT(point_partial, 0);  // the edge pixels, partly covered
+  EXPECT_GT(point_partial, 0);                   // the edge pixels, partly covered
   EXPECT_GT(sphere_partial, 2 * point_partial);  // measured: 119 against 33
 }
 
@@ -176,6 +177,34 @@ TEST(PrefilteredOpacity, HasTheExpectationOfStochasticShadowsWithLessNoise) {
     mse_p += mse(image(OpacityKind::kPrefiltered, 1, seed));
   }
   EXPECT_LT(mse_p, mse_s);
+}
+
+TEST(CompositeOpacity, HasTheDeterministicImageWithOneShadowRayPerLightPerSample) {
+  // The field from above at footprint 16, one directional light. Composite blends what a
+  // camera ray crosses as the deterministic model does (and stops when it is saturated), but
+  // traces the shadow rays of one member only: the same expected image, at most one shadow
+  // ray per sample (the deterministic model: one per translucent member as well).
+  Params none("scenes/field.json");
+  LoadedScene s = load_scene(AMALGAM_SOURCE_DIR "/scenes/field.json", none);
+  CameraChoice aerial;
+  aerial.eye = Vec3{0, 120, 160}, aerial.look_at = Vec3{0, 0, 0};
+  choose_camera(s, aerial);
+  ASSERT_EQ(s.env.lights.size(), 1u);
+  RenderOptions o;
+  o.footprint = 16.0f, o.width = 32, o.height = 24, o.threads = 2, o.seed = 9;
+  o.opacity = OpacityKind::kDeterministic, o.spp = 64;
+  const RenderOutput det = render(s, o);
+  o.opacity = OpacityKind::kComposite, o.spp = 256;
+  const RenderOutput comp = render(s, o);
+  EXPECT_NEAR(mean(comp.image) / mean(det.image), 1.0, 0.003);
+  double se = 0;
+  for (std::size_t i = 0; i < det.image.size(); ++i) {
+    const Vec3 d = comp.image[i] - det.image[i];
+    se += dot(d, d);
+  }
+  EXPECT_LT(std::sqrt(se / (3.0 * det.image.size())), 0.01);
+  EXPECT_LE(comp.counters.rays[1], comp.counters.rays[0]);
+  EXPECT_GT(det.counters.rays[1] * 256, comp.counters.rays[1] * 64);  // per sample: more
 }
 
 }  // namespace

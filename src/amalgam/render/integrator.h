@@ -47,6 +47,7 @@ class Integrator {
     translucent_.clear();
     const TraceHit hit =
         trav_.intersect(primary, hash_combine(key, 0), Opacity::kBlends ? &translucent_ : nullptr);
+    if constexpr (Opacity::kSaturates) return li_composite(primary, key, hit);
     std::uint64_t shadow_stream = 1;
     SampleResult r{{}, hit};
     const Vec3 wo = -primary.dir;
@@ -93,13 +94,82 @@ class Integrator {
   }
 
   /// A rendered amalgam `id` with appearance `app`, entered at `s`.
+  /// Without kShadows, as if every shadow ray reached its light (no ray is traced).
+  template <bool kShadows = true>
   Vec3 shade(const Ray& primary, NodeId id, const Appearance& app, const SurfaceHit& s,
              std::uint64_t key, std::uint64_t& stream) {
     if (app.shading == Shading::kFace) {
-      return direct(primary, s, shading_normal(app, s), app.surface, key, stream);
+      return direct<false, kShadows>(primary, s, shading_normal(app, s), app.surface, key, stream);
     }
-    return direct<true>(primary, s, shading_normal(app, s), app.surface, key, stream, &id,
-                        app.shading == Shading::kCloud);
+    return direct<true, kShadows>(primary, s, shading_normal(app, s), app.surface, key, stream, &id,
+                                  app.shading == Shading::kCloud);
+  }
+
+  /// li() under CompositeOpacity: the translucent amalgams in front of the hit blended front
+  /// to back with weights w_k = T_k a_k (the hit, or the background, gets what is left), each
+  /// shaded without shadows (U_k, no rays); then one member j, chosen with probability
+  /// p_j = w_j lum(U_j) / sum_k w_k lum(U_k), is shaded with its shadow rays (D_j) and
+  /// counts w_j D_j / p_j. Its expectation is sum_k w_k D_k, the deterministic model's image,
+  /// with one set of shadow rays per sample instead of one per member.
+  SampleResult li_composite(const Ray& primary, std::uint64_t key, const TraceHit& hit) {
+    std::sort(translucent_.begin(), translucent_.end(), [](const auto& a, const auto& b) {
+      return a.t < b.t || (a.t == b.t && a.id < b.id);
+    });
+    const float t_end = hit.kind == TraceHit::Kind::kNone ? kInfinity : hit.t;
+    SampleResult r{{}, hit};
+    const Vec3 wo = -primary.dir;
+    float through = 1.0f;
+    std::uint64_t none = 0;  // unshadowed shading traces no ray
+    members_.clear();
+    for (std::size_t k = 0; k < translucent_.size() && translucent_[k].t < t_end; ++k) {
+      const TranslucentHit& a = translucent_[k];
+      const Appearance app = h_.appearance(a.id);
+      const float w = through * a.opacity;
+      members_.push_back(
+          {w, shade<false>(primary, a.id, app, a.surf, key, none), static_cast<int>(k)});
+      r.normal += amalgam_normal(app, a.surf, wo) * w;
+      r.albedo += app.surface.colour * w;
+      through *= 1.0f - a.opacity;
+    }
+    Surface hit_surface{};
+    if (hit.kind == TraceHit::Kind::kPrimitive) {
+      hit_surface = surface_at(h_, hit.id, hit.surf);
+      members_.push_back(
+          {through,
+           direct<false, false>(primary, hit.surf, hit.surf.normal, hit_surface, key, none), -1});
+      r.normal += facing(hit.surf.normal, wo) * through;
+      r.albedo += hit_surface.colour * through;
+    } else if (hit.kind == TraceHit::Kind::kAmalgam) {
+      const Appearance app = h_.appearance(hit.id);
+      members_.push_back({through, shade<false>(primary, hit.id, app, hit.surf, key, none), -1});
+      r.normal += amalgam_normal(app, hit.surf, wo) * through;
+      r.albedo += app.surface.colour * through;
+    } else {
+      r.colour += env_.background * through;
+    }
+    auto lum = [](Vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; };
+    float total = 0.0f;
+    for (const Member& m : members_) total += m.w * lum(m.u);
+    if (!(total > 0.0f)) return r;  // nothing lit even without shadows
+    float x = to_unit_float(hash_combine(key, 0x636f6d70)) * total;  // which member
+    std::size_t j = 0;
+    while (j + 1 < members_.size() && x >= members_[j].w * lum(members_[j].u))
+      x -= members_[j].w * lum(members_[j].u), ++j;
+    const Member& m = members_[j];
+    const float p = m.w * lum(m.u) / total;
+    if (!(p > 0.0f)) return r;
+    std::uint64_t stream = 1;
+    Vec3 d;
+    if (m.k >= 0) {
+      const TranslucentHit& a = translucent_[static_cast<std::size_t>(m.k)];
+      d = shade(primary, a.id, h_.appearance(a.id), a.surf, key, stream);
+    } else if (hit.kind == TraceHit::Kind::kPrimitive) {
+      d = direct(primary, hit.surf, hit.surf.normal, hit_surface, key, stream);
+    } else {
+      d = shade(primary, hit.id, h_.appearance(hit.id), hit.surf, key, stream);
+    }
+    r.colour += d * (m.w / p);
+    return r;
   }
 
   /// Reflectance x cosine of a cloud of isotropically oriented Lambertian facets (uniform
@@ -132,7 +202,7 @@ class Integrator {
   /// face may be turned from a light that still reaches them; a shadow ray toward such a light
   /// starts where the line toward the light leaves the amalgam's box (the amalgam's own
   /// self-shadowing is in its normal's cosine or, with `cloud`, in cloud_response()).
-  template <bool kBaked = false>
+  template <bool kBaked = false, bool kShadows = true>
   Vec3 direct(const Ray& primary, const SurfaceHit& s, Vec3 n, const Surface& surf,
               std::uint64_t key, std::uint64_t& stream, const NodeId* amalgam = nullptr,
               bool cloud = false) {
@@ -164,8 +234,8 @@ class Integrator {
           ls.dist = kInfinity;
           ls.e = light.intensity;
         }
-        sum += one_shadow_ray<kBaked>(primary, s, n_shade, surf, key, stream, amalgam, cloud,
-                                      light, ls, origin, wo);
+        sum += one_shadow_ray<kBaked, kShadows>(primary, s, n_shade, surf, key, stream, amalgam,
+                                                cloud, light, ls, origin, wo);
       }
     }
     return sum;
@@ -173,7 +243,7 @@ class Integrator {
 
   /// One shadow ray of direct(): light sample `ls` of `light` seen from `origin` (offset from
   /// the hit `s`); what it brings if unoccluded, times the response toward `wo`.
-  template <bool kBaked>
+  template <bool kBaked, bool kShadows>
   Vec3 one_shadow_ray(const Ray& primary, const SurfaceHit& s, Vec3 n, const Surface& surf,
                       std::uint64_t key, std::uint64_t& stream, const NodeId* amalgam, bool cloud,
                       const Light& light, const LightSample& ls, Vec3 origin, Vec3 wo) {
@@ -204,18 +274,21 @@ class Integrator {
     } else if (dot(s.normal, wi) <= 0.0f) {
       return {};
     }
-    Ray shadow = Ray::make(from, wi, 0.0f, dist * (1.0f - 2.0f * gamma(3)));
-    // The shadow rays of one pixel leave its footprint on the surface and travel to the
-    // light: a parallel beam of the footprint's width toward a directional light, a beam
-    // narrowing to nothing at a point light. (Spreading it like the camera cone made distant
-    // occluders render as amalgams although their shadows span many pixels.) Toward a sized
-    // light the beam ends as wide as its share of the light (render/lights.h).
-    shadow.cone_width = primary.footprint(s.t);
-    if (light.kind == LightKind::kPoint)
-      shadow.cone_spread = (ls.end_width - shadow.cone_width) / std::max(dist, 1e-30f);
-    else
-      shadow.cone_spread = ls.spread;
-    const float tr = trav_.transmittance(shadow, hash_combine(key, stream++));
+    float tr = 1.0f;
+    if constexpr (kShadows) {
+      Ray shadow = Ray::make(from, wi, 0.0f, dist * (1.0f - 2.0f * gamma(3)));
+      // The shadow rays of one pixel leave its footprint on the surface and travel to the
+      // light: a parallel beam of the footprint's width toward a directional light, a beam
+      // narrowing to nothing at a point light. (Spreading it like the camera cone made distant
+      // occluders render as amalgams although their shadows span many pixels.) Toward a sized
+      // light the beam ends as wide as its share of the light (render/lights.h).
+      shadow.cone_width = primary.footprint(s.t);
+      if (light.kind == LightKind::kPoint)
+        shadow.cone_spread = (ls.end_width - shadow.cone_width) / std::max(dist, 1e-30f);
+      else
+        shadow.cone_spread = ls.spread;
+      tr = trav_.transmittance(shadow, hash_combine(key, stream++));
+    }
     if (tr <= 0.0f) return {};
     return (cloud ? cloud_response(surf, wi, wo) : brdf(surf, n, wi, wo)) * ls.e * (f_cos * tr);
   }
@@ -224,6 +297,14 @@ class Integrator {
   const Environment& env_;
   Tracer trav_;
   std::vector<TranslucentHit> translucent_;
+  /// A member of a composite (li_composite): its weight, unshadowed radiance, and index in
+  /// translucent_ (-1: the hit).
+  struct Member {
+    float w;
+    Vec3 u;
+    int k;
+  };
+  std::vector<Member> members_;
 };
 
 AMALGAM_ISA_END

@@ -25,9 +25,9 @@ namespace amalgam {
 AMALGAM_ISA_BEGIN
 
 struct LightSample {
-  Vec3 wi;           ///< unit direction toward the light
-  float dist = 0.0f;  ///< distance to the light along wi (infinity: directional)
-  Vec3 e;            ///< light arriving (irradiance normal to wi), this sample's share
+  Vec3 wi;                 ///< unit direction toward the light
+  float dist = 0.0f;       ///< distance to the light along wi (infinity: directional)
+  Vec3 e;                  ///< light arriving (irradiance normal to wi), this sample's share
   float end_width = 0.0f;  ///< sphere: the width the shadow ray's cone should have at it
   float spread = 0.0f;     ///< disc (directional): the cone's widening per unit distance
 };

@@ -11,10 +11,12 @@ namespace amalgam {
 enum class RendererKind : std::uint8_t { kScaleSensitive, kTraditional };
 /// The opacity models (traverse/opacity.h): the paper's two, and kPrefiltered, stochastic for
 /// camera rays and deterministic (prefiltered) attenuation for shadow rays.
-enum class OpacityKind : std::uint8_t { kStochastic, kDeterministic, kPrefiltered };
+/// kComposite: deterministic for every ray, camera rays stopping when their coverage saturates,
+/// one shadow computation per camera ray.
+enum class OpacityKind : std::uint8_t { kStochastic, kDeterministic, kPrefiltered, kComposite };
 /// The names of --opacity, indexed by OpacityKind.
-inline constexpr std::array<std::string_view, 3> kOpacityNames = {"stochastic", "deterministic",
-                                                                   "prefiltered"};
+inline constexpr std::array<std::string_view, 4> kOpacityNames = {"stochastic", "deterministic",
+                                                                  "prefiltered", "composite"};
 inline std::string_view opacity_name(OpacityKind k) {
   return kOpacityNames[static_cast<std::size_t>(k)];
 }

@@ -31,6 +31,7 @@ auto dispatch(const LoadedScene& scene, const RenderOptions& o, F&& f) {
           };
           if (o.opacity == OpacityKind::kStochastic) return with_opacity(StochasticOpacity{});
           if (o.opacity == OpacityKind::kPrefiltered) return with_opacity(PrefilteredOpacity{});
+          if (o.opacity == OpacityKind::kComposite) return with_opacity(CompositeOpacity{});
           return with_opacity(DeterministicOpacity{});
         };
         if (o.renderer == RendererKind::kTraditional) return with_lod(TraditionalLod{});

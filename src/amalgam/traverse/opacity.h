@@ -31,6 +31,9 @@ enum class AmalgamEffect : std::uint8_t {
 struct StochasticOpacity {
   /// Whether closest-hit rays collect translucent amalgams for blending.
   static constexpr bool kBlends = false;
+  /// Whether a closest-hit ray stops once what it blended leaves less than
+  /// kSaturatedTransmittance of the light behind (CompositeOpacity).
+  static constexpr bool kSaturates = false;
   AmalgamEffect effect(float a, std::uint64_t ray_key, NodeId id, bool /*shadow*/) const {
     return to_unit_float(hash_combine(ray_key, id)) < a ? AmalgamEffect::kStop
                                                         : AmalgamEffect::kPass;
@@ -42,8 +45,8 @@ struct StochasticOpacity {
 /// attenuated by (1 - a).
 struct DeterministicOpacity {
   static constexpr bool kBlends = true;
-  AmalgamEffect effect(float a, std::uint64_t /*ray_key*/, NodeId /*id*/,
-                       bool /*shadow*/) const {
+  static constexpr bool kSaturates = false;
+  AmalgamEffect effect(float a, std::uint64_t /*ray_key*/, NodeId /*id*/, bool /*shadow*/) const {
     if (a >= 1.0f) return AmalgamEffect::kStop;
     if (a <= 0.0f) return AmalgamEffect::kPass;
     return AmalgamEffect::kBlend;
@@ -60,9 +63,28 @@ struct DeterministicOpacity {
 /// rather than stopping at the first one that is opaque for it, so it costs more tests.
 struct PrefilteredOpacity {
   static constexpr bool kBlends = false;
+  static constexpr bool kSaturates = false;
   AmalgamEffect effect(float a, std::uint64_t ray_key, NodeId id, bool shadow) const {
     if (shadow) return DeterministicOpacity{}.effect(a, ray_key, id, shadow);
     return StochasticOpacity{}.effect(a, ray_key, id, shadow);
+  }
+};
+
+/// Below this transmittance a blending closest-hit ray of CompositeOpacity stops: what lies
+/// behind would add less than 0.1 % of its radiance.
+inline constexpr float kSaturatedTransmittance = 1e-3f;
+
+/// Composite (not the paper's): every ray treats translucent amalgams deterministically, as
+/// DeterministicOpacity does, but a camera ray stops once its coverage saturates
+/// (kSaturatedTransmittance) and the integrator shades the blend with the shadow rays of one
+/// member chosen in proportion to its share, not one set per member (render/integrator.h):
+/// the image of sub-pixel geometry without coverage noise, at about the stochastic model's
+/// number of shadow rays.
+struct CompositeOpacity {
+  static constexpr bool kBlends = true;
+  static constexpr bool kSaturates = true;
+  AmalgamEffect effect(float a, std::uint64_t ray_key, NodeId id, bool shadow) const {
+    return DeterministicOpacity{}.effect(a, ray_key, id, shadow);
   }
 };
 

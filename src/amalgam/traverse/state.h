@@ -112,6 +112,10 @@ struct RayState {
           transmittance *= 1.0f - a;
         } else if (translucent) {
           translucent->push_back({t, id, level, box_entry_hit(ray, b, t), a});
+          if constexpr (Opacity::kSaturates) {
+            transmittance *= 1.0f - a;
+            if (transmittance < kSaturatedTransmittance) done = true;
+          }
         }
         return;
       case AmalgamEffect::kStop:

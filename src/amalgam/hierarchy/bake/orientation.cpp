@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <bit>
 #include <functional>
 #include <vector>
@@ -37,10 +38,17 @@ int closed_orientation(std::span<const Primitive> prims) {
   // Degenerate triangles (two vertices the same) are left out: their keys sort last.
   constexpr std::uint64_t kSkip = ~std::uint64_t{0};
   std::atomic<std::size_t> skipped{0};
-  // Six times the enclosed signed volume.
-  const double volume = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, tris.size(), 4096), 0.0,
-      [&](const tbb::blocked_range<std::size_t>& r, double v) {
+  // Six times the enclosed signed volume; twice the vector area (sum of the triangles'
+  // (b - a) x (c - a)) and twice the total area.
+  struct Sums {
+    double volume = 0, sx = 0, sy = 0, sz = 0, area = 0;
+    Sums operator+(const Sums& o) const {
+      return {volume + o.volume, sx + o.sx, sy + o.sy, sz + o.sz, area + o.area};
+    }
+  };
+  const Sums sums = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, tris.size(), 4096), Sums{},
+      [&](const tbb::blocked_range<std::size_t>& r, Sums v) {
         for (std::size_t i = r.begin(); i < r.end(); ++i) {
           const Primitive& t = *tris[i];
           const std::uint64_t k[3] = {key(t.a), key(t.b), key(t.c)};
@@ -55,12 +63,16 @@ int closed_orientation(std::span<const Primitive> prims) {
             edges[3 * i + static_cast<std::size_t>(e)] = (h & ~std::uint64_t{1}) | (a < b ? 0 : 1);
           }
           const Vec3 c = cross(t.b, t.c);
-          v += static_cast<double>(t.a.x) * c.x + static_cast<double>(t.a.y) * c.y +
-               static_cast<double>(t.a.z) * c.z;
+          v.volume += static_cast<double>(t.a.x) * c.x + static_cast<double>(t.a.y) * c.y +
+                      static_cast<double>(t.a.z) * c.z;
+          const Vec3 n = cross(t.b - t.a, t.c - t.a);
+          v.sx += n.x, v.sy += n.y, v.sz += n.z;
+          v.area += length(n);
         }
         return v;
       },
-      std::plus<double>());
+      std::plus<Sums>());
+  const double volume = sums.volume;
   tbb::parallel_sort(edges.begin(), edges.end());
   edges.resize(edges.size() - skipped.load());
   if (edges.empty()) return 0;
@@ -76,6 +88,11 @@ int closed_orientation(std::span<const Primitive> prims) {
     i = j;
   }
   if (paired * 20 < edges.size() * 19) return 0;
+  // A closed surface has no vector area (the flux of a constant field through it is 0); a
+  // finely tessellated open one (subdivided grass blades: few boundary edges among many) has
+  // about its area's worth or, for many sheets at random, a good fraction of it.
+  const double vector_area = std::sqrt(sums.sx * sums.sx + sums.sy * sums.sy + sums.sz * sums.sz);
+  if (vector_area > 0.02 * sums.area) return 0;
   return volume > 0.0 ? 1 : volume < 0.0 ? -1 : 0;
 }
 
