@@ -69,7 +69,7 @@ struct Args {
   double ref_se = 0.002;
   bool quick = false, no_embree = false, oracle_box = false;
   std::string opacity = "stochastic";  ///< of the scale-sensitive curves
-  int light_samples = 0;               ///< shadow rays per sized light in every curve (0: the scene's)
+  int light_samples = 0;  ///< shadow rays per sized light in every curve (0: the scene's)
 };
 
 std::string loadavg() {
@@ -345,7 +345,8 @@ int run(int argc, char** argv) {
                  "shadow rays per sized light in every measured curve (default: the scene's; "
                  "the reference keeps the scene's)")
       ->check(CLI::Range(0, 4096));
-  app.add_option("--oracle-footprints", a.oracle_ks, "footprints K of the oracle (empty: none)");
+  app.add_option("--oracle-footprints", a.oracle_ks,
+                 "footprints K of the oracle (none or empty: no oracle)");
   app.add_option("--oracle-rays", a.oracle_rays, "full-detail rays per oracle estimate");
   app.add_option("--oracle-spp", a.oracle_spp, "samples per pixel of the oracle renders");
   app.add_option("--oracle-runs", a.oracle_runs, "runs (seeds) of each oracle render");
@@ -366,8 +367,9 @@ int run(int argc, char** argv) {
   std::filesystem::create_directories(a.out);
   const std::vector<int> spps = parse_ints(a.spps);
   const std::vector<float> ks = parse_floats(a.ks);
-  const std::vector<float> oks =
-      a.oracle_ks.empty() ? std::vector<float>{} : parse_floats(a.oracle_ks);
+  const std::vector<float> oks = a.oracle_ks.empty() || a.oracle_ks == "none"
+                                     ? std::vector<float>{}
+                                     : parse_floats(a.oracle_ks);
   json result;
   result["scene"] = a.scene, result["view"] = a.view;
   result["width"] = a.width, result["height"] = a.height, result["threads"] = a.threads;
