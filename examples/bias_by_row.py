@@ -24,6 +24,8 @@ def main():
     ap.add_argument("--width", type=int, default=256)
     ap.add_argument("--height", type=int, default=192)
     ap.add_argument("--footprint", type=float, default=1.0)
+    ap.add_argument("--opacity", default="stochastic",
+                    help="opacity model of the amalgam render (stochastic, prefiltered, composite, ...)")
     ap.add_argument("--spp", type=int, default=64, help="samples of the amalgam render")
     ap.add_argument("--ref-spp", type=int, default=128, help="samples of the full-detail one")
     ap.add_argument("--band", type=int, default=4, help="rows per band")
@@ -33,8 +35,8 @@ def main():
     ref = scene.render(width=a.width, height=a.height, spp=a.ref_spp, renderer="traditional",
                        seed=11, threads=a.threads)
     lod = scene.render(width=a.width, height=a.height, spp=a.spp, footprint=a.footprint, seed=3,
-                       threads=a.threads)
-    print(f"# {a.scene}, {a.width}x{a.height}, footprint {a.footprint}: RMSE "
+                       threads=a.threads, opacity=a.opacity)
+    print(f"# {a.scene}, {a.width}x{a.height}, footprint {a.footprint}, {a.opacity}: RMSE "
           f"{amalgam.compare(lod, ref)['rmse']:.4f}; rows where the reference hits something")
     print("| rows | in amalgams | luminance | albedo | visible normal, full detail | "
           "visible normal, amalgams |")

@@ -131,8 +131,19 @@ class Integrator {
       r.albedo += app.surface.colour * w;
       through *= 1.0f - a.opacity;
     }
+    if (through < kSaturatedTransmittance) {
+      // Saturated (the traversal stops there): the little left is taken to look like the
+      // blend, whose weights are scaled up to sum to 1, rather than like nothing.
+      const float scale = 1.0f / (1.0f - through);
+      for (Member& m : members_) m.w *= scale;
+      r.normal = r.normal * scale;
+      r.albedo = r.albedo * scale;
+      through = 0.0f;
+    }
     Surface hit_surface{};
-    if (hit.kind == TraceHit::Kind::kPrimitive) {
+    if (through == 0.0f) {
+      // saturated: neither the hit nor the background shows
+    } else if (hit.kind == TraceHit::Kind::kPrimitive) {
       hit_surface = surface_at(h_, hit.id, hit.surf);
       members_.push_back(
           {through,
@@ -253,7 +264,8 @@ class Integrator {
     const float f_cos = cloud ? 1.0f : dot(n, wi);  // a cloud has it in its response
     if (f_cos <= 0.0f) return {};
     if constexpr (kBaked) {
-      if (dot(s.normal, wi) <= 0.0f) {
+      // (Without a shadow ray, no origin is needed.)
+      if (kShadows && dot(s.normal, wi) <= 0.0f) {
         // Leave the box on the light's side: enter it backwards from beyond.
         const Bbox box = h_.bounds(*amalgam);
         const float reach = 2.0f * length(box.hi - box.lo) + 1e-6f;

@@ -31,7 +31,7 @@ enum class AmalgamEffect : std::uint8_t {
 struct StochasticOpacity {
   /// Whether closest-hit rays collect translucent amalgams for blending.
   static constexpr bool kBlends = false;
-  /// Whether a closest-hit ray stops once what it blended leaves less than
+  /// Whether a closest-hit ray ends where what it blended, front to back, leaves less than
   /// kSaturatedTransmittance of the light behind (CompositeOpacity).
   static constexpr bool kSaturates = false;
   AmalgamEffect effect(float a, std::uint64_t ray_key, NodeId id, bool /*shadow*/) const {
@@ -70,12 +70,13 @@ struct PrefilteredOpacity {
   }
 };
 
-/// Below this transmittance a blending closest-hit ray of CompositeOpacity stops: what lies
-/// behind would add less than 0.1 % of its radiance.
-inline constexpr float kSaturatedTransmittance = 1e-3f;
+/// Below this transmittance a blending closest-hit ray of CompositeOpacity ends (nothing
+/// deeper is looked for); the integrator scales the blend's weights to sum to 1 (what lies
+/// behind is taken to look like what was blended).
+inline constexpr float kSaturatedTransmittance = 0.02f;
 
 /// Composite (not the paper's): every ray treats translucent amalgams deterministically, as
-/// DeterministicOpacity does, but a camera ray stops once its coverage saturates
+/// DeterministicOpacity does, but a camera ray ends where its coverage saturates
 /// (kSaturatedTransmittance) and the integrator shades the blend with the shadow rays of one
 /// member chosen in proportion to its share, not one set per member (render/integrator.h):
 /// the image of sub-pixel geometry without coverage noise, at about the stochastic model's

@@ -8,7 +8,9 @@
 /// counted as an amalgam on the levels where the LOD policy may render, else as a bounding
 /// volume.
 
+#include <algorithm>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "amalgam/geometry/intersect.h"
@@ -21,6 +23,22 @@
 
 namespace amalgam {
 AMALGAM_ISA_BEGIN
+
+/// The depth at which the translucent amalgams `hits`, blended front to back, leave less than
+/// kSaturatedTransmittance of the light behind: the entry of the one that saturates them
+/// (infinity if they do not).
+inline float saturation_depth(const std::vector<TranslucentHit>& hits) {
+  thread_local std::vector<std::pair<float, float>> by_depth;
+  by_depth.clear();
+  for (const TranslucentHit& h : hits) by_depth.push_back({h.t, h.opacity});
+  std::sort(by_depth.begin(), by_depth.end());
+  float through = 1.0f;
+  for (const auto& [t, a] : by_depth) {
+    through *= 1.0f - a;
+    if (through < kSaturatedTransmittance) return t;
+  }
+  return kInfinity;
+}
 
 /// One traversal's state: the hierarchy and policies it runs with, and the ray in flight.
 /// `Stats` is Counters (exact counts) or NullCounters (counting compiled out).
@@ -113,8 +131,13 @@ struct RayState {
         } else if (translucent) {
           translucent->push_back({t, id, level, box_entry_hit(ray, b, t), a});
           if constexpr (Opacity::kSaturates) {
+            // Once what was collected can saturate the ray, nothing beyond the depth where it
+            // does, front to back, can show: the ray ends there. (Stopping the walk itself
+            // would be wrong: it collects in subtree order, not depth order, and may not have
+            // met a nearer primitive yet.)
             transmittance *= 1.0f - a;
-            if (transmittance < kSaturatedTransmittance) done = true;
+            if (transmittance < kSaturatedTransmittance)
+              ray.tmax = std::min(ray.tmax, saturation_depth(*translucent));
           }
         }
         return;
