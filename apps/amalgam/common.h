@@ -79,6 +79,7 @@ struct RenderExtras {
   bool quiet = false;
   std::string max_memory;          ///< as given (parse_bytes); empty: the machine's physical memory
   double checkpoint_every = 60.0;  ///< seconds between checkpoints during a render
+  double rank_timeout = 600.0;     ///< under mpirun: seconds a rank may hold a tile (docs/mpi.md)
 };
 
 int run_render(CommonOptions& common, const RenderExtras& extra);
