@@ -196,7 +196,21 @@ struct Worker {
   int tile = -1;         ///< the tile it renders, -1: none
   Clock::time_point since{};
   bool lost = false;  ///< silent with a tile for longer than the timeout
+  /// The message being sent to it, sent without blocking: a blocking send of a tile larger than
+  /// the eager limit would wait for the rank to receive it, forever if it died.
+  std::vector<char> out;
+  MPI_Request request = MPI_REQUEST_NULL;
 };
+
+/// Sends `bytes` to rank `r` without waiting for it to be received. The previous message to it
+/// was received already (it answered), so completing its request does not wait.
+void post(int r, Worker& w, Tag tag, std::vector<char> bytes) {
+  check(MPI_Wait(&w.request, MPI_STATUS_IGNORE), "MPI_Wait");
+  w.out = std::move(bytes);
+  check(MPI_Isend(w.out.data(), static_cast<int>(w.out.size()), MPI_BYTE, r, tag, MPI_COMM_WORLD,
+                  &w.request),
+        "MPI_Isend");
+}
 
 struct Dispatcher {
   std::vector<Worker> workers;
@@ -414,7 +428,7 @@ RenderOutput render_root(const LoadedScene& scene, const RenderOptions& o, FilmS
             holder[static_cast<std::size_t>(index)] = r;
           }
           const FilmTile prior = cut_tile(st, tiles[static_cast<std::size_t>(index)]);
-          send(r, kWork, work_message(round, index, prior, s0, s1));
+          post(r, w, kWork, work_message(round, index, prior, s0, s1));
           w.waiting = false;
           w.tile = index;
           w.since = Clock::now();
@@ -503,8 +517,12 @@ bool release() {
       }
       receive(status);  // a late tile or a cancellation: the outputs are written already
     }
-    send(r, kStop, {});
+    post(r, w, kStop, {});
     w.waiting = false;
+  }
+  for (int r = 1; r < g_size; ++r) {  // the stops are small: sent at once
+    Worker& w = g_dispatch.workers[static_cast<std::size_t>(r)];
+    if (!w.lost && w.request != MPI_REQUEST_NULL) MPI_Wait(&w.request, MPI_STATUS_IGNORE);
   }
   g_in_render = !all;
   return all;
