@@ -12,6 +12,9 @@
 #include "amalgam/analysis/experiments.h"
 #include "amalgam/util/atomic_file.h"
 #include "common.h"
+#if defined(AMALGAM_HAVE_MPI)
+#include "mpi_render.h"
+#endif
 
 namespace amalgam::cli {
 namespace {
@@ -154,6 +157,45 @@ std::string section(const ex::ExperimentResult& r, bool plotted, bool gnuplot) {
   return o.str();
 }
 
+/// What the report and the files need of one experiment, as text.
+struct Computed {
+  std::string csv, gp, section_plotted, section_unplotted, verdict, seconds;
+  int passed = 0, checks = 0;
+
+  /// Length-prefixed fields (a message between ranks).
+  std::string pack() const {
+    std::string out;
+    for (const std::string* f :
+         {&csv, &gp, &section_plotted, &section_unplotted, &verdict, &seconds}) {
+      out += std::to_string(f->size()) + ":";
+      out += *f;
+    }
+    out += std::to_string(passed) + ":" + std::to_string(checks) + ":";
+    return out;
+  }
+  static Computed unpack(const std::string& in) {
+    Computed c;
+    std::size_t at = 0;
+    auto number = [&] {
+      const std::size_t colon = in.find(':', at);
+      if (colon == std::string::npos) throw RuntimeError("experiment: a malformed result");
+      const std::size_t v = std::stoul(in.substr(at, colon - at));
+      at = colon + 1;
+      return v;
+    };
+    for (std::string* f :
+         {&c.csv, &c.gp, &c.section_plotted, &c.section_unplotted, &c.verdict, &c.seconds}) {
+      const std::size_t len = number();
+      if (at + len > in.size()) throw RuntimeError("experiment: a malformed result");
+      *f = in.substr(at, len);
+      at += len;
+    }
+    c.passed = static_cast<int>(number());
+    c.checks = static_cast<int>(number());
+    return c;
+  }
+};
+
 }  // namespace
 
 int run_experiment(const std::string& name, const std::string& out_dir, bool quick, int threads) {
@@ -170,12 +212,39 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
     }
   }
   const fs::path dir(out_dir);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir))
-    throw InputError("--out " + out_dir + ": cannot create the directory (" + ec.message() + ")");
-  const bool gnuplot = have_gnuplot();
-  if (!gnuplot) std::cerr << "amalgam: gnuplot is not on PATH; writing CSVs and the report only\n";
+#if defined(AMALGAM_HAVE_MPI)
+  const bool parallel = mpi::parallel(), root = !parallel || mpi::rank() == 0;
+#else
+  const bool root = true;
+#endif
+  bool gnuplot = false;
+  // Under mpirun only rank 0 writes; a failure of its directory must stop every rank.
+  std::exception_ptr failure;
+  try {
+    if (root) {
+      std::error_code ec;
+      fs::create_directories(dir, ec);
+      if (ec || !fs::is_directory(dir))
+        throw InputError("--out " + out_dir + ": cannot create the directory (" + ec.message() +
+                         ")");
+      gnuplot = have_gnuplot();
+      if (!gnuplot)
+        std::cerr << "amalgam: gnuplot is not on PATH; writing CSVs and the report only\n";
+    }
+  } catch (...) {
+#if defined(AMALGAM_HAVE_MPI)
+    if (!parallel) throw;
+    failure = std::current_exception();
+#else
+    throw;
+#endif
+  }
+#if defined(AMALGAM_HAVE_MPI)
+  if (parallel) {
+    if (const int st = mpi::agree(failure)) return st;
+    gnuplot = mpi::broadcast(gnuplot ? "1" : "0") == "1";  // the report says rank 0's
+  }
+#endif
   ex::Config config;
   config.quick = quick;
   config.threads = threads;
@@ -190,22 +259,53 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
   report << "| experiment | verdict | checks passed | seconds |\n|---|---|---|---|\n";
   std::ostringstream body;
   int failures = 0;
-  for (const std::string& n : todo) {
-    std::cerr << "amalgam: experiment " << n << " ..." << std::flush;
+  // One experiment's outputs as text: computed here or, under mpirun, on any rank
+  // (mpi::spread), then written by this process (rank 0) in report order.
+  auto compute = [&](const std::string& n) {
     const ex::ExperimentResult r = ex::run(n, config);
-    write_file_atomic((dir / (n + ".csv")).string(), csv(r.table));
-    write_file_atomic((dir / (n + ".gp")).string(), gnuplot_script(r, n + ".csv", n + ".png.tmp"));
-    const bool plotted = gnuplot && plot(dir, n);
     int passed = 0;
     for (const auto& c : r.checks) passed += c.passed();
-    failures += static_cast<int>(r.checks.size()) - passed;
-    std::cerr << " " << ex::to_string(r.verdict) << ", " << passed << "/" << r.checks.size()
-              << " checks, " << ex::fmt(r.seconds) << " s\n";
-    std::cout << n << ": " << ex::to_string(r.verdict) << " (" << passed << "/" << r.checks.size()
-              << " checks)\n";
-    report << "| [" << n << "](#" << n << ") | " << ex::to_string(r.verdict) << " | " << passed
-           << "/" << r.checks.size() << " | " << ex::fmt(r.seconds) << " |\n";
-    body << section(r, plotted, gnuplot);
+    Computed c;
+    c.csv = csv(r.table);
+    c.gp = gnuplot_script(r, n + ".csv", n + ".png.tmp");
+    c.section_plotted = section(r, true, gnuplot);
+    c.section_unplotted = section(r, false, gnuplot);
+    c.verdict = ex::to_string(r.verdict);
+    c.passed = passed;
+    c.checks = static_cast<int>(r.checks.size());
+    c.seconds = ex::fmt(r.seconds);
+    return c;
+  };
+  auto emit = [&](const std::string& n, const Computed& c) {
+    write_file_atomic((dir / (n + ".csv")).string(), c.csv);
+    write_file_atomic((dir / (n + ".gp")).string(), c.gp);
+    const bool plotted = gnuplot && plot(dir, n);
+    failures += c.checks - c.passed;
+    std::cerr << " " << c.verdict << ", " << c.passed << "/" << c.checks << " checks, " << c.seconds
+              << " s\n";
+    std::cout << n << ": " << c.verdict << " (" << c.passed << "/" << c.checks << " checks)\n";
+    report << "| [" << n << "](#" << n << ") | " << c.verdict << " | " << c.passed << "/"
+           << c.checks << " | " << c.seconds << " |\n";
+    body << (plotted ? c.section_plotted : c.section_unplotted);
+  };
+#if defined(AMALGAM_HAVE_MPI)
+  if (mpi::parallel()) {
+    mpi::spread(
+        static_cast<int>(todo.size()),
+        [&](int i) { return compute(todo[static_cast<std::size_t>(i)]).pack(); },
+        [&](int i, const std::string& packed) {
+          const std::string& n = todo[static_cast<std::size_t>(i)];
+          std::cerr << "amalgam: experiment " << n << " ..." << std::flush;
+          emit(n, Computed::unpack(packed));
+        });
+    if (mpi::rank() != 0) return 0;
+  } else
+#endif
+  {
+    for (const std::string& n : todo) {
+      std::cerr << "amalgam: experiment " << n << " ..." << std::flush;
+      emit(n, compute(n));
+    }
   }
   report << "\n" << body.str();
   write_file_atomic((dir / "report.md").string(), report.str());

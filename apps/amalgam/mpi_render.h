@@ -15,7 +15,9 @@
 
 #include <atomic>
 #include <exception>
+#include <functional>
 #include <string>
+#include <vector>
 
 #include "amalgam/render/render.h"
 
@@ -69,6 +71,14 @@ void serve(const LoadedScene& scene, const RenderOptions& options, const std::at
 /// under way). Returns false, after saying which, when a rank was lost (the caller then ends
 /// the job with abort()).
 bool release();
+
+/// Runs jobs 0 .. n - 1 spread over the ranks (`amalgam experiment` under mpirun): rank 0 hands
+/// them out one at a time from a queue and runs its own share on a thread of its own. On rank 0,
+/// calls `done(i, output of job i)` for every job in order 0 .. n - 1 as soon as the jobs up to i
+/// are finished; other ranks return once every job is done. A job that throws fails the run:
+/// its message, with the rank, is thrown again on rank 0 (RuntimeError) after every rank stops.
+void spread(int n, const std::function<std::string(int)>& job,
+            const std::function<void(int, const std::string&)>& done);
 
 /// Ends every rank of the job now (MPI_Abort) with `status`.
 [[noreturn]] void abort(int status);

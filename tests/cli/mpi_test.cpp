@@ -277,4 +277,48 @@ TEST(CliMpi, ARankThatCannotLoadTheSceneStopsEveryRankWithItsMessage) {
   EXPECT_FALSE(fs::exists(d.path / "x.pfm"));
 }
 
+/// A CSV without its wall-time columns (seconds, microseconds per ray): what two runs share.
+std::string untimed_csv(const fs::path& file) {
+  std::istringstream in(slurp(file));
+  std::string line, out;
+  std::vector<bool> keep;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string c; std::getline(row, c, ',');) cells.push_back(c);
+    if (keep.empty())
+      for (const std::string& c : cells)
+        keep.push_back(c.find("seconds") == std::string::npos &&
+                       c.find("us_per") == std::string::npos);
+    for (std::size_t i = 0; i < cells.size() && i < keep.size(); ++i)
+      if (keep[i]) out += cells[i] + ",";
+    out += "\n";
+  }
+  return out;
+}
+
+TEST(CliMpi, ExperimentSweepsOverThreeRanksGiveTheResultsOfOneProcess) {
+  SKIP_WITHOUT_MPIRUN();
+  Dir d("exp");
+  const std::string args = " experiment all --quick --threads 1 --out ";
+  const auto one = run_command(kBinary + args + (d.path / "one").string() + " 2>/dev/null");
+  const auto three =
+      run_command(mpirun(3) + " " + kBinary + args + (d.path / "three").string() + " 2>/dev/null");
+  ASSERT_EQ(one.status, 0);
+  ASSERT_EQ(three.status, 0);
+  // The verdicts and check counts, in report order (the last line names the directory).
+  EXPECT_EQ(three.out.substr(0, three.out.rfind("report:")),
+            one.out.substr(0, one.out.rfind("report:")));
+  int csvs = 0;
+  for (const auto& e : fs::directory_iterator(d.path / "one")) {
+    if (e.path().extension() != ".csv") continue;
+    ++csvs;
+    const fs::path other = d.path / "three" / e.path().filename();
+    ASSERT_TRUE(fs::exists(other)) << other;
+    EXPECT_EQ(untimed_csv(other), untimed_csv(e.path())) << e.path().filename();
+  }
+  EXPECT_EQ(csvs, 9);
+  EXPECT_TRUE(fs::exists(d.path / "three" / "report.md"));
+}
+
 }  // namespace
