@@ -301,7 +301,7 @@ std::string broadcast(const std::string& text) {
 
 RenderOutput render_root(const LoadedScene& scene, const RenderOptions& o, FilmState* resume,
                          const RenderControl& control, const std::atomic<int>& signal,
-                         double timeout, Stop& stop) {
+                         double timeout, double round_seconds, Stop& stop) {
   const auto t0 = Clock::now();
   FilmState local;
   FilmState& st = resume ? *resume : local;
@@ -313,11 +313,16 @@ RenderOutput render_root(const LoadedScene& scene, const RenderOptions& o, FilmS
   std::vector<Worker>& workers = g_dispatch.workers;
   const std::vector<TileRect> tiles = plan_tiles(o.width, o.height, g_size);
   const std::size_t pixels = static_cast<std::size_t>(o.width) * o.height;
-  // Rounds of about 2^16 primary rays per rank (a single process's pass for each).
-  const int per_round = samples_per_pass(std::max<std::size_t>(1, pixels / g_size));
+  // The first round: about 2^16 primary rays per rank (a single process's pass for each).
+  // Every round moves each pixel's running sums to a rank and back through rank 0 (about 120
+  // bytes a pixel), so rounds then double while one takes less than half of round_seconds:
+  // the gather becomes a small part of a long render. The image does not depend on the
+  // rounds; only how much an interruption drops does.
+  int per_round = samples_per_pass(std::max<std::size_t>(1, pixels / g_size));
   bool interrupted = false;
   for (int round = 0; st.spp_done < o.spp && !interrupted; ++round) {
     const int s0 = st.spp_done, s1 = std::min(o.spp, s0 + per_round);
+    const auto round_start = Clock::now();
     FilmState next;  // the film after this round: its pixels, tile by tile
     next.width = st.width;
     next.height = st.height;
@@ -483,6 +488,8 @@ RenderOutput render_root(const LoadedScene& scene, const RenderOptions& o, FilmS
     st.per_primary.merge(per_primary);
     st.spp_done = s1;
     if (control.on_pass) control.on_pass(st);
+    const double took = std::chrono::duration<double>(Clock::now() - round_start).count();
+    if (took < 0.5 * round_seconds && per_round < (1 << 20)) per_round *= 2;
     if (control.cancel && control.cancel->load() && st.spp_done < o.spp) {
       stop.signal = signal.load();
       interrupted = true;

@@ -54,13 +54,15 @@ struct Stop {
   std::string missing;  ///< the tiles of the unfinished round not returned, and their holders
 };
 
-/// Rank 0: renders `options` as render() does (resume, control), with the ranks' help; a rank
-/// silent for `timeout` seconds with a tile is taken as lost (said on stderr) and its tile is
-/// rendered by the others. `signal` is the signal this process received (0: none). Sets `stop`
-/// when interrupted.
+/// Rank 0: renders `options` as render() does (resume, control), with the ranks' help, in
+/// rounds of samples that double while one lasts less than half of `round_seconds` (0: rounds
+/// of a single process's pass); control.on_pass is called after each. A rank silent for
+/// `timeout` seconds with a tile is taken as lost (said on stderr) and its tile is rendered by
+/// the others. `signal` is the signal this process received (0: none). Sets `stop` when
+/// interrupted.
 RenderOutput render_root(const LoadedScene& scene, const RenderOptions& options, FilmState* resume,
                          const RenderControl& control, const std::atomic<int>& signal,
-                         double timeout, Stop& stop);
+                         double timeout, double round_seconds, Stop& stop);
 
 /// Ranks > 0: renders the tiles rank 0 hands out until it says stop. `cancel` (this process's
 /// SIGINT/SIGTERM) stops the tile under way and tells rank 0, which stops every rank.

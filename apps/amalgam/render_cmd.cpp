@@ -325,7 +325,9 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
   double embree_build = 0.0;
 #if defined(AMALGAM_HAVE_MPI)
   if (parallel)
-    r = mpi::render_root(scene, o, &state, control, g_signal, extra.rank_timeout, stop);
+    // Rounds as long as the checkpoint interval: a checkpoint is written at the end of one.
+    r = mpi::render_root(scene, o, &state, control, g_signal, extra.rank_timeout,
+                         extra.checkpoint_every, stop);
   else
 #endif
 #if defined(AMALGAM_HAVE_EMBREE)
