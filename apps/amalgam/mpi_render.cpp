@@ -299,7 +299,7 @@ std::string broadcast(const std::string& text) {
   return out;
 }
 
-RenderOutput render_root(const LoadedScene& scene, const RenderOptions& o, FilmState* resume,
+RenderOutput render_root(const TileRenderer& render_tile, const RenderOptions& o, FilmState* resume,
                          const RenderControl& control, const std::atomic<int>& signal,
                          double timeout, double round_seconds, Stop& stop) {
   const auto t0 = Clock::now();
@@ -359,7 +359,7 @@ RenderOutput render_root(const LoadedScene& scene, const RenderOptions& o, FilmS
           holder[static_cast<std::size_t>(index)] = 0;
         }
         FilmTile t = cut_tile(st, tiles[static_cast<std::size_t>(index)]);
-        if (!render_tile(scene, o, t, s0, s1, &local_cancel)) return;
+        if (!render_tile(t, s0, s1, &local_cancel)) return;
         std::lock_guard<std::mutex> lock(mutex);
         local_done.emplace_back(index, std::move(t));
       }
@@ -636,7 +636,7 @@ void spread(int n, const std::function<std::string(int)>& job,
   }
 }
 
-void serve(const LoadedScene& scene, const RenderOptions& o, const std::atomic<bool>& cancel,
+void serve(const TileRenderer& render_tile, const RenderOptions& o, const std::atomic<bool>& cancel,
            const std::atomic<int>& signal) {
   g_in_render = true;
   send(0, kReady, {});
@@ -665,7 +665,7 @@ void serve(const LoadedScene& scene, const RenderOptions& o, const std::atomic<b
       t.tests.assign(rect.pixels(), 0);
       t.aov.assign(rect.pixels(), PixelAov{});
     }
-    if (!cancel.load() && render_tile(scene, o, t, s0, s1, &cancel))
+    if (!cancel.load() && render_tile(t, s0, s1, &cancel))
       send(0, kResult, result_message(round, index, t));
     else
       send(0, kCancelled, signal_message(signal.load()));

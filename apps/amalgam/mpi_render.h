@@ -47,6 +47,11 @@ int agree(std::exception_ptr failure);
 /// Rank 0 sends `text` to every rank; returns rank 0's text on every rank.
 std::string broadcast(const std::string& text);
 
+/// Renders samples s0 .. s1 - 1 into a tile (render_tile or render_tile_embree); false when
+/// `cancel` stopped it.
+using TileRenderer =
+    std::function<bool(FilmTile& tile, int s0, int s1, const std::atomic<bool>* cancel)>;
+
 /// Why a parallel render stopped early (rank 0).
 struct Stop {
   int signal = 0;       ///< the signal that stopped it (SIGINT or SIGTERM)
@@ -60,14 +65,15 @@ struct Stop {
 /// `timeout` seconds with a tile is taken as lost (said on stderr) and its tile is rendered by
 /// the others. `signal` is the signal this process received (0: none). Sets `stop` when
 /// interrupted.
-RenderOutput render_root(const LoadedScene& scene, const RenderOptions& options, FilmState* resume,
-                         const RenderControl& control, const std::atomic<int>& signal,
-                         double timeout, double round_seconds, Stop& stop);
+RenderOutput render_root(const TileRenderer& render_tile, const RenderOptions& options,
+                         FilmState* resume, const RenderControl& control,
+                         const std::atomic<int>& signal, double timeout, double round_seconds,
+                         Stop& stop);
 
 /// Ranks > 0: renders the tiles rank 0 hands out until it says stop. `cancel` (this process's
 /// SIGINT/SIGTERM) stops the tile under way and tells rank 0, which stops every rank.
-void serve(const LoadedScene& scene, const RenderOptions& options, const std::atomic<bool>& cancel,
-           const std::atomic<int>& signal);
+void serve(const TileRenderer& render_tile, const RenderOptions& options,
+           const std::atomic<bool>& cancel, const std::atomic<int>& signal);
 
 /// Rank 0, once its outputs are written: tells every rank to stop (waiting for tiles still
 /// under way). Returns false, after saying which, when a rank was lost (the caller then ends

@@ -223,8 +223,6 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
     common.finish();
     if (!extra.cost_range.empty()) given_range = parse_cost_range(extra.cost_range);
     if (root) check_outputs(extra, ckpt, o);  // the outputs are rank 0's
-    if (parallel && o.tracer == TracerKind::kEmbree)
-      throw InputError("--tracer embree: not under mpirun (render it with one process)");
     const std::uint64_t asked =
         extra.max_memory.empty() ? 0 : parse_bytes(extra.max_memory, "--max-memory");
     if (!extra.max_memory.empty() && asked == 0)
@@ -293,8 +291,16 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
 #if defined(AMALGAM_HAVE_MPI)
+  // What renders a tile on this rank: amalgam's traversal or Embree, as for one process.
+  const mpi::TileRenderer tile_renderer = [&](FilmTile& t, int s0, int s1,
+                                              const std::atomic<bool>* cancel) {
+#if defined(AMALGAM_HAVE_EMBREE)
+    if (embree) return render_tile_embree(*embree_scene, o, t, s0, s1, cancel);
+#endif
+    return render_tile(scene, o, t, s0, s1, cancel);
+  };
   if (!root) {
-    mpi::serve(scene, o, g_cancel, g_signal);
+    mpi::serve(tile_renderer, o, g_cancel, g_signal);
     return 0;
   }
   // Rank 0, once its outputs are written (or not): the other ranks are told to stop; one that
@@ -322,21 +328,20 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
   };
   set_activity("rendering " + common.scene);
   RenderOutput r;
-  double embree_build = 0.0;
 #if defined(AMALGAM_HAVE_MPI)
-  if (parallel)
+  if (parallel) {
     // Rounds as long as the checkpoint interval: a checkpoint is written at the end of one.
-    r = mpi::render_root(scene, o, &state, control, g_signal, extra.rank_timeout,
+    r = mpi::render_root(tile_renderer, o, &state, control, g_signal, extra.rank_timeout,
                          extra.checkpoint_every, stop);
-  else
+  }
 #endif
+  double embree_build = 0.0;
 #if defined(AMALGAM_HAVE_EMBREE)
-      if (embree) {
-    r = render_embree(*embree_scene, o, &state, control);
-    embree_build = embree_scene->build_seconds();
-  } else
+  if (embree && !parallel) r = render_embree(*embree_scene, o, &state, control);
+  if (embree) embree_build = embree_scene->build_seconds();
 #endif
-    r = render(scene, o, &state, control);  // finish() refused --tracer embree without Embree
+  // (finish() refused --tracer embree in a build without Embree.)
+  if (!embree && !parallel) r = render(scene, o, &state, control);
   progress.finish();
   set_activity("writing the outputs of " + common.scene);
   // The work is done: writing its results wins over further signals (on_signal).

@@ -183,6 +183,28 @@ TEST(CliMpi, StratifiedSamplingAndTwoRanksToo) {
   EXPECT_EQ(slurp(p("two.pfm")), slurp(p("one.pfm")));
 }
 
+#if defined(AMALGAM_HAVE_EMBREE)
+TEST(CliMpi, EmbreeRendersTheSameBytesOverRanks) {
+  SKIP_WITHOUT_MPIRUN();
+  Dir d("embree");
+  const auto p = [&](const std::string& f) { return (d.path / f).string(); };
+  const std::string args = kScene + " --spp 100 --tracer embree --renderer traditional";
+  ASSERT_EQ(
+      sh(kBinary + args + " --out " + p("one.pfm") + " --stats " + p("one.json"), d.path / "err1"),
+      0)
+      << slurp(d.path / "err1");
+  ASSERT_EQ(sh(mpirun(3) + " " + kBinary + args + " --threads 1 --out " + p("three.pfm") +
+                   " --stats " + p("three.json"),
+               d.path / "err3"),
+            0)
+      << slurp(d.path / "err3");
+  EXPECT_FALSE(slurp(p("one.pfm")).empty());
+  EXPECT_EQ(slurp(p("three.pfm")), slurp(p("one.pfm")));
+  nlohmann::json one = counts(p("one.json")), three = counts(p("three.json"));
+  EXPECT_EQ(three, one);
+}
+#endif
+
 TEST(CliMpi, AnInterruptedRenderResumesWithAnotherRankCountAndWithOneProcess) {
   SKIP_WITHOUT_MPIRUN();
   Dir d("resume");
