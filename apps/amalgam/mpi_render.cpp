@@ -344,26 +344,36 @@ RenderOutput render_root(const TileRenderer& render_tile, const RenderOptions& o
       --remaining;
     };
 
-    // Rank 0's own share: a thread that takes tiles from the same queue.
+    // Rank 0's own share: a thread that takes tiles from the same queue until it is empty
+    // (started again when a lost rank's tile goes back into it).
     std::mutex mutex;
     std::vector<std::pair<int, FilmTile>> local_done;
     std::atomic<bool> local_cancel{false};
-    std::thread own([&] {
-      for (;;) {
-        int index = -1;
-        {
+    std::atomic<bool> own_running{true};
+    std::exception_ptr own_failure;  // under `mutex`
+    auto own_share = [&] {
+      try {
+        for (;;) {
+          int index = -1;
+          {
+            std::lock_guard<std::mutex> lock(mutex);
+            if (todo.empty() || local_cancel.load()) break;
+            index = todo.front();
+            todo.pop_front();
+            holder[static_cast<std::size_t>(index)] = 0;
+          }
+          FilmTile t = cut_tile(st, tiles[static_cast<std::size_t>(index)]);
+          if (!render_tile(t, s0, s1, &local_cancel)) break;
           std::lock_guard<std::mutex> lock(mutex);
-          if (todo.empty() || local_cancel.load()) return;
-          index = todo.front();
-          todo.pop_front();
-          holder[static_cast<std::size_t>(index)] = 0;
+          local_done.emplace_back(index, std::move(t));
         }
-        FilmTile t = cut_tile(st, tiles[static_cast<std::size_t>(index)]);
-        if (!render_tile(t, s0, s1, &local_cancel)) return;
+      } catch (...) {
         std::lock_guard<std::mutex> lock(mutex);
-        local_done.emplace_back(index, std::move(t));
+        own_failure = std::current_exception();
       }
-    });
+      own_running.store(false);
+    };
+    std::thread own(own_share);
 
     std::exception_ptr failure;
     try {
@@ -371,9 +381,15 @@ RenderOutput render_root(const TileRenderer& render_tile, const RenderOptions& o
         bool busy = false;
         {
           std::lock_guard<std::mutex> lock(mutex);
+          if (own_failure) std::rethrow_exception(own_failure);
           for (auto& [index, t] : local_done) merge(index, t);
           busy = !local_done.empty();
           local_done.clear();
+          if (!own_running.load() && !todo.empty()) {  // a tile came back: render it here too
+            own.join();
+            own_running.store(true);
+            own = std::thread(own_share);
+          }
         }
         MPI_Status status;
         int flag = 0;
