@@ -286,7 +286,7 @@ int agree(std::exception_ptr failure) {
     }
   }
   if (worst != 0 && g_rank == 0)
-    std::cerr << "amalgam: another rank failed before rendering (its message above): nothing "
+    std::cerr << "amalgam: another rank failed before rendering (see its message): nothing "
                  "written\n";
   return worst;
 }
