@@ -40,7 +40,7 @@ namespace amalgam {
 /// renders stops the ray.
 struct StopAtEveryAmalgam {
   static constexpr bool kBlends = false;
-  AmalgamEffect effect(float, std::uint64_t, NodeId) const { return AmalgamEffect::kStop; }
+  AmalgamEffect effect(float, std::uint64_t, NodeId, bool) const { return AmalgamEffect::kStop; }
 };
 
 template <Hierarchy H>

@@ -49,8 +49,16 @@ class Scene:
         order: str = "sorted",  # or "unsorted"
         seed: int = 0,
         threads: int = 0,  # 0: all cores
+        sampler: str = "independent",  # or "stratified"
+        camera: Optional[Union[str, int]] = None,
+        eye: Optional[Sequence[float]] = None,
+        look_at: Optional[Sequence[float]] = None,
+        up: Optional[Sequence[float]] = None,
+        fov: Optional[float] = None,
+        light_samples: Optional[int] = None,
     ) -> RenderResult:
-        """Renders the camera view; KeyboardInterrupt carries `.partial` (a RenderResult)."""
+        """Renders the camera view (camera=, eye=, look_at=, up=, fov= change it for this
+        render only, from the view `load` chose); KeyboardInterrupt carries `.partial`."""
     def trace(
         self,
         origin: Optional[Sequence[float]] = None,
@@ -85,7 +93,10 @@ def compare(
 ) -> dict[str, float]:
     """width, height, rmse, psnr, ssim, mean_abs, max_abs, rel_mse (b the reference)."""
 
-def experiment(name: str, quick: bool = True, threads: int = 0) -> list[dict[str, float]]:
-    """One of the paper's analyses; its table as a list of rows."""
+def experiment(
+    name: str, quick: bool = True, threads: int = 0, frame: bool = False
+) -> Union[list[dict[str, float]], Any]:
+    """One of the paper's analyses; its table as a list of rows, or with frame=True as a
+    pandas.DataFrame (columns in the CSV's order)."""
 
 def experiment_names() -> list[str]: ...

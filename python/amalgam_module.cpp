@@ -64,14 +64,14 @@ struct Options {
 Options make_options(int width, int height, int spp, const std::string& renderer,
                      const std::string& opacity, std::optional<int> level,
                      std::optional<float> footprint, const std::string& order, std::uint64_t seed,
-                     int threads) {
+                     int threads, const std::string& sampler = "independent") {
   // The checks and messages of the CLI (apps/amalgam/common.cpp, CommonOptions::finish).
   if (renderer != "scale-sensitive" && renderer != "traditional")
     throw InputError("--renderer " + one_line(renderer, 40) +
                      ": expected scale-sensitive or traditional");
-  if (opacity != "stochastic" && opacity != "deterministic")
+  if (!parse_opacity(opacity))
     throw InputError("--opacity " + one_line(opacity, 40) +
-                     ": expected stochastic or deterministic");
+                     ": expected stochastic, deterministic or prefiltered");
   if (order != "sorted" && order != "unsorted")
     throw InputError("--order " + one_line(order, 40) + ": expected sorted or unsorted");
   if (level && footprint)
@@ -90,15 +90,18 @@ Options make_options(int width, int height, int spp, const std::string& renderer
   if (spp < 1) throw InputError("--spp " + std::to_string(spp) + ": expected an integer >= 1");
   if (threads < 0)
     throw InputError("--threads " + std::to_string(threads) + ": expected an integer >= 0");
+  if (sampler != "independent" && sampler != "stratified")
+    throw InputError("--sampler " + one_line(sampler, 40) + ": expected independent or stratified");
   Options r;
   r.o.renderer =
       renderer == "traditional" ? RendererKind::kTraditional : RendererKind::kScaleSensitive;
-  r.o.opacity = opacity == "deterministic" ? OpacityKind::kDeterministic : OpacityKind::kStochastic;
+  r.o.opacity = *parse_opacity(opacity);
   r.o.level = level;
   r.o.footprint = footprint ? *footprint : 1.0f;
   r.o.sorted = order == "sorted";
   r.o.seed = seed;
   r.o.threads = threads;
+  r.o.sampler = sampler == "stratified" ? PixelSampler::kStratified : PixelSampler::kIndependent;
   r.o.width = width;
   r.o.height = height;
   r.o.spp = spp;
@@ -159,6 +162,56 @@ std::shared_ptr<RenderResult> make_result(const LoadedScene& scene, const Render
   return res;
 }
 
+/// A view keyword (eye=, look_at=, up=) as a Vec3; the CLI's message otherwise.
+Vec3 view_vec(const py::handle& v, const std::string& option) {
+  std::vector<float> x;
+  try {
+    x = v.cast<std::vector<float>>();
+  } catch (const py::cast_error&) {
+  }
+  const std::string text = py::str(v).cast<std::string>();
+  if (x.size() != 3 || !is_finite(Vec3{x[0], x[1], x[2]}))
+    throw InputError(option + " '" + text + "': expected three numbers x,y,z");
+  return {x[0], x[1], x[2]};
+}
+
+/// One view keyword (camera=, eye=, look_at=, up=, fov=: the CLI's --camera, --eye, --look-at,
+/// --up, --fov) into `view`; false when `key` is not one of them.
+bool view_keyword(const std::string& key, const py::handle& value, CameraChoice& view) {
+  if (key == "camera") {
+    view.camera = py::str(value).cast<std::string>();
+  } else if (key == "eye") {
+    view.eye = view_vec(value, "--eye");
+  } else if (key == "look_at") {
+    view.look_at = view_vec(value, "--look-at");
+  } else if (key == "up") {
+    view.up = view_vec(value, "--up");
+  } else if (key == "light_samples") {
+    int n = 0;
+    try {
+      n = value.cast<int>();
+    } catch (const py::cast_error&) {
+      throw InputError("--light-samples " + one_line(py::str(value).cast<std::string>(), 40) +
+                       ": expected an integer in [1, 4096]");
+    }
+    view.light_samples = n;
+  } else if (key == "fov") {
+    const std::string text = py::str(value).cast<std::string>();
+    double x = NAN;
+    try {
+      x = value.cast<double>();
+    } catch (const py::cast_error&) {
+    }
+    if (!(x > 0.0 && x < 180.0))
+      throw InputError("--fov " + one_line(text, 40) +
+                       ": expected a vertical field of view in degrees, > 0 and < 180");
+    view.fov_deg = static_cast<float>(x);
+  } else {
+    return false;
+  }
+  return true;
+}
+
 /// A loaded scene: the built, baked hierarchy, shared by every render of it.
 struct Scene {
   std::shared_ptr<const LoadedScene> scene;
@@ -169,20 +222,33 @@ struct Scene {
   std::shared_ptr<RenderResult> render(int width, int height, int spp, const std::string& renderer,
                                        const std::string& opacity, std::optional<int> level,
                                        std::optional<float> footprint, const std::string& order,
-                                       std::uint64_t seed, int threads) {
+                                       std::uint64_t seed, int threads, const std::string& sampler,
+                                       const py::object& camera,
+                                       const py::object& eye, const py::object& look_at,
+                                       const py::object& up, const py::object& fov,
+                                       const py::object& light_samples) {
     const Options opt =
-        make_options(width, height, spp, renderer, opacity, level, footprint, order, seed, threads);
+        make_options(width, height, spp, renderer, opacity, level, footprint, order, seed, threads,
+                     sampler);
     check_options(*scene, opt.o);
+    // Another view of the same built, baked scene: only the environment is new.
+    CameraChoice view;
+    const std::pair<const char*, const py::object*> keys[] = {
+        {"camera", &camera}, {"eye", &eye},  {"look_at", &look_at},
+        {"up", &up},         {"fov", &fov}, {"light_samples", &light_samples}};
+    for (const auto& [key, value] : keys)
+      if (!value->is_none()) view_keyword(key, *value, view);
+    auto env = std::make_shared<const Environment>(chosen_view(*scene, view));
     // The render runs on its own thread while this one, without the GIL, waits for it and
     // every 50 ms takes the GIL to run Python's signal handlers (PyErr_CheckSignals): a
     // KeyboardInterrupt cancels the render at its next tile (RenderControl::cancel).
     auto cancel = std::make_shared<std::atomic<bool>>(false);
     std::shared_ptr<const LoadedScene> keep = scene;
     const RenderOptions o = opt.o;
-    std::packaged_task<RenderOutput()> task([keep, o, cancel] {
+    std::packaged_task<RenderOutput()> task([keep, env, o, cancel] {
       RenderControl control;
       control.cancel = cancel.get();
-      return amalgam::render(*keep, o, nullptr, control);
+      return amalgam::render(*keep, *env, o, nullptr, control);
     });
     std::future<RenderOutput> done = task.get_future();
     std::optional<py::error_already_set> interrupt;
@@ -247,48 +313,14 @@ struct Scene {
   }
 };
 
-/// A view keyword of `load` (eye=, look_at=, up=) as a Vec3; the CLI's message otherwise.
-Vec3 view_vec(const py::handle& v, const std::string& option) {
-  std::vector<float> x;
-  try {
-    x = v.cast<std::vector<float>>();
-  } catch (const py::cast_error&) {
-  }
-  const std::string text = py::str(v).cast<std::string>();
-  if (x.size() != 3 || !is_finite(Vec3{x[0], x[1], x[2]}))
-    throw InputError(option + " '" + text + "': expected three numbers x,y,z");
-  return {x[0], x[1], x[2]};
-}
-
 std::shared_ptr<Scene> load(const std::string& spec, const py::kwargs& params) {
-  // The view keywords are the CLI's --camera, --eye, --look-at, --up and --fov (no builtin
-  // has a parameter of these names); the others are builtin parameters (--set key=value).
+  // The view keywords are the CLI's view options (no builtin has a parameter of these names);
+  // the others are builtin parameters (--set key=value).
   Params p(spec);
   CameraChoice view;
   for (auto item : params) {
     const std::string key = py::str(item.first).cast<std::string>();
-    if (key == "camera") {
-      view.camera = py::str(item.second).cast<std::string>();
-    } else if (key == "eye") {
-      view.eye = view_vec(item.second, "--eye");
-    } else if (key == "look_at") {
-      view.look_at = view_vec(item.second, "--look-at");
-    } else if (key == "up") {
-      view.up = view_vec(item.second, "--up");
-    } else if (key == "fov") {
-      const std::string text = py::str(item.second).cast<std::string>();
-      double x = NAN;
-      try {
-        x = item.second.cast<double>();
-      } catch (const py::cast_error&) {
-      }
-      if (!(x > 0.0 && x < 180.0))
-        throw InputError("--fov " + one_line(text, 40) +
-                         ": expected a vertical field of view in degrees, > 0 and < 180");
-      view.fov_deg = static_cast<float>(x);
-    } else {
-      p.set(key, py::str(item.second).cast<std::string>());
-    }
+    if (!view_keyword(key, item.second, view)) p.set(key, py::str(item.second).cast<std::string>());
   }
   auto s = std::make_shared<Scene>();
   s->spec = spec;
@@ -341,7 +373,7 @@ py::dict compare(const py::object& a, const py::object& b) {
   return d;
 }
 
-py::list experiment(const std::string& name, bool quick, int threads) {
+py::object experiment(const std::string& name, bool quick, int threads, bool frame) {
   const auto& names = experiments::names();
   if (std::find(names.begin(), names.end(), name) == names.end()) {
     std::string all;
@@ -362,7 +394,12 @@ py::list experiment(const std::string& name, bool quick, int threads) {
       d[py::str(r.table.columns[i])] = row[i];
     rows.append(d);
   }
-  return rows;
+  if (!frame) return rows;
+  // pandas is optional: imported only when a DataFrame is asked for (ImportError otherwise).
+  py::object pandas = py::module_::import("pandas");
+  py::list columns;
+  for (const auto& c : r.table.columns) columns.append(py::str(c));
+  return pandas.attr("DataFrame")(rows, py::arg("columns") = columns);
 }
 
 }  // namespace
@@ -429,8 +466,15 @@ PYBIND11_MODULE(amalgam, m) {
            py::arg("spp") = 4, py::arg("renderer") = "scale-sensitive",
            py::arg("opacity") = "stochastic", py::arg("level") = py::none(),
            py::arg("footprint") = py::none(), py::arg("order") = "sorted", py::arg("seed") = 0,
-           py::arg("threads") = 0,
-           "Renders the scene's camera view; the options are the CLI's (docs/cli.md). The same\n"
+           py::arg("threads") = 0, py::arg("sampler") = "independent",
+           py::arg("camera") = py::none(), py::arg("eye") = py::none(),
+           py::arg("look_at") = py::none(), py::arg("up") = py::none(), py::arg("fov") = py::none(),
+           py::arg("light_samples") = py::none(),
+           "Renders the scene's camera view; the options are the CLI's (docs/cli.md). camera=\n"
+           "(name or index), eye=, look_at=, up= (x, y, z) and fov= (degrees) change the view\n"
+           "of this render only, as --camera, --eye, --look-at, --up and --fov do, starting from\n"
+           "the view `load` chose; the scene is not rebuilt or rebaked. light_samples= is\n"
+           "--light-samples (shadow rays per sized light). The same\n"
            "seed gives the same image as `amalgam render ... --out x.pfm`, bit for bit, on any\n"
            "number of threads. The GIL is released. Ctrl-C (KeyboardInterrupt) stops the render\n"
            "at its next tile; the exception's `partial` attribute (and scene.last_result) holds\n"
@@ -471,9 +515,12 @@ PYBIND11_MODULE(amalgam, m) {
         "Image metrics of `amalgam compare` for two H x W x 3 images (arrays or RenderResults),\n"
         "b the reference: width, height, rmse, psnr, ssim, mean_abs, max_abs, rel_mse.");
   m.def("experiment", &experiment, py::arg("name"), py::arg("quick") = true, py::arg("threads") = 0,
-        "experiment(name, quick=True, threads=0) -> list[dict]\n\n"
+        py::arg("frame") = false,
+        "experiment(name, quick=True, threads=0, frame=False) -> list[dict] | pandas.DataFrame\n\n"
         "Runs one of the paper's analyses (`amalgam experiment NAME`) and returns its table\n"
-        "(the CSV's rows) as a list of dicts keyed by column. The GIL is released.");
+        "(the CSV's rows) as a list of dicts keyed by column, or with frame=True as a pandas\n"
+        "DataFrame with the CSV's columns in order (ImportError when pandas is not installed).\n"
+        "The GIL is released.");
   m.def(
       "experiment_names", [] { return experiments::names(); },
       "The experiment names in report order.");

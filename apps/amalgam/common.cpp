@@ -15,8 +15,11 @@ void CommonOptions::add_to(CLI::App& app) {
   renderer_option =
       app.add_option("--renderer", renderer, "scale-sensitive (default) or traditional")
           ->check(CLI::IsMember({"scale-sensitive", "traditional"}));
-  opacity_option = app.add_option("--opacity", opacity, "stochastic (default) or deterministic")
-                       ->check(CLI::IsMember({"stochastic", "deterministic"}));
+  opacity_option =
+      app.add_option("--opacity", opacity,
+                     "stochastic (default), deterministic, or prefiltered (stochastic for camera "
+                     "rays, deterministic for shadow rays)")
+          ->check(CLI::IsMember({"stochastic", "deterministic", "prefiltered"}));
   level_option =
       app.add_option("--level", level, "scale-sensitive: render the amalgams met on level L")
           ->check(non_negative_int());
@@ -51,6 +54,10 @@ void CommonOptions::add_to(CLI::App& app) {
   app.add_option("--look-at", look_at, "point the camera looks at, x,y,z");
   app.add_option("--up", up, "camera up direction x,y,z");
   app.add_option("--fov", fov, "vertical field of view in degrees (0 < DEG < 180)");
+  app.add_option("--light-samples", light_samples,
+                 "shadow rays per shading point for every sized light (sphere or sun disc; "
+                 "default: each light's \"samples\")")
+      ->check(CLI::Range(1, 4096));
 }
 
 void CommonOptions::prepare(LoadedScene& scene) const {
@@ -92,8 +99,7 @@ void CommonOptions::finish() {
     if (order_option && order_option->count() > 0) refuse("--order (Embree orders its own)");
     options.renderer = RendererKind::kTraditional;
   }
-  options.opacity =
-      opacity == "deterministic" ? OpacityKind::kDeterministic : OpacityKind::kStochastic;
+  options.opacity = parse_opacity(opacity).value_or(OpacityKind::kStochastic);
   options.sorted = order == "sorted";
   options.level = level >= 0 ? std::optional<int>(level) : std::nullopt;
   options.footprint = footprint;
@@ -118,6 +124,7 @@ void CommonOptions::finish() {
                        ": expected a vertical field of view in degrees, > 0 and < 180");
     view.fov_deg = static_cast<float>(x);
   }
+  if (light_samples > 0) view.light_samples = light_samples;
 }
 
 Params CommonOptions::params() const {

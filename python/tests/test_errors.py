@@ -118,3 +118,9 @@ def test_bad_view_keywords_are_value_errors(cli, tmp_path):
         amalgam.load("builtin:demo", eye=(1, 2))
     with pytest.raises(ValueError, match="--camera"):
         amalgam.load("builtin:demo", camera="nope")
+    scene = amalgam.load("builtin:demo")
+    with pytest.raises(ValueError) as e:
+        scene.render(width=4, height=4, spp=1, fov=200)
+    assert str(e.value) == message
+    with pytest.raises(ValueError, match="--up"):
+        scene.render(width=4, height=4, spp=1, up=(0, 0, 1), eye=(0, 0, 3), look_at=(0, 0, 0))

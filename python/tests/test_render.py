@@ -1,6 +1,7 @@
 """Scene.render: bit-identity with the CLI's PFM, shapes, dtypes, stats, reuse, threads."""
 
 import json
+import pathlib
 import subprocess
 import threading
 
@@ -30,6 +31,9 @@ def read_pfm(path):
         (["--renderer", "traditional"], {"renderer": "traditional"}),
         (["--level", "4", "--opacity", "deterministic"], {"level": 4, "opacity": "deterministic"}),
         (["--footprint", "3", "--order", "unsorted"], {"footprint": 3.0, "order": "unsorted"}),
+        (["--opacity", "prefiltered", "--footprint", "2"],
+         {"opacity": "prefiltered", "footprint": 2.0}),
+        (["--sampler", "stratified"], {"sampler": "stratified"}),
     ],
 )
 def test_same_bits_as_cli_pfm(cli, demo, tmp_path, args, kwargs):
@@ -141,6 +145,16 @@ def test_experiment():
     assert all(isinstance(v, float) for v in rows[0].values())
 
 
+def test_experiment_as_dataframe():
+    import pandas  # scripts/deps.sh installs python3-pandas: a missing one fails the test
+
+    rows = amalgam.experiment("linear-cost", quick=True)
+    frame = amalgam.experiment("linear-cost", quick=True, frame=True)
+    assert isinstance(frame, pandas.DataFrame)
+    assert list(frame.columns) == list(rows[0])
+    assert frame.to_dict("records") == rows
+
+
 def test_view_keywords_as_cli(cli, tmp_path):
     out = tmp_path / "v.pfm"
     view = ["--eye", "0.5,0.5,3", "--look-at", "0.5,0.5,0.5", "--fov", "30"]
@@ -151,3 +165,47 @@ def test_view_keywords_as_cli(cli, tmp_path):
     assert np.array_equal(r.image.view(np.uint32), read_pfm(out).view(np.uint32))
     default = amalgam.load("builtin:demo").render(width=24, height=16, spp=2)
     assert not np.array_equal(r.image, default.image)
+
+
+def test_view_keywords_of_render_change_that_render_only(cli, demo, tmp_path):
+    """render(eye=, look_at=, fov=) = the CLI's view options, on the shared, loaded scene."""
+    out = tmp_path / "v.pfm"
+    view = ["--eye", "0.5,0.5,3", "--look-at", "0.5,0.5,0.5", "--fov", "30"]
+    subprocess.run([cli, "render", "builtin:demo", "--width", "24", "--height", "16", "--spp",
+                    "2", "--out", str(out), *view], check=True, capture_output=True)
+    before = demo.render(width=24, height=16, spp=2)
+    r = demo.render(width=24, height=16, spp=2, eye=(0.5, 0.5, 3), look_at=(0.5, 0.5, 0.5),
+                    fov=30)
+    assert np.array_equal(r.image.view(np.uint32), read_pfm(out).view(np.uint32))
+    after = demo.render(width=24, height=16, spp=2)
+    assert not np.array_equal(r.image, before.image)
+    assert np.array_equal(after.image.view(np.uint32), before.image.view(np.uint32))
+
+
+def test_camera_of_render_is_the_files_camera(cli, tmp_path):
+    gltf = "/usr/share/assimp/models/glTF2/cameras/Cameras.gltf"
+    out = tmp_path / "c.pfm"
+    subprocess.run([cli, "render", gltf, "--camera", "0", "--width", "20", "--height", "20",
+                    "--spp", "1", "--out", str(out)], check=True, capture_output=True)
+    s = amalgam.load(gltf, eye=(3, 2, 5))  # another view at load; camera= replaces it
+    moved = s.render(width=20, height=20, spp=1)
+    r = s.render(width=20, height=20, spp=1, camera="nodes[1]")
+    assert np.array_equal(r.image.view(np.uint32), read_pfm(out).view(np.uint32))
+    assert not np.array_equal(moved.image, r.image)
+    with pytest.raises(ValueError, match="no such camera"):
+        s.render(width=4, height=4, spp=1, camera="nope")
+
+
+def test_light_samples_as_cli(cli, tmp_path):
+    """--light-samples / light_samples= on a scene with a sized light (the soft field)."""
+    path = str(pathlib.Path(__file__).resolve().parents[2] / "scenes" / "field-soft.json")
+    out = tmp_path / "s.pfm"
+    subprocess.run([cli, "render", path, "--width", "16", "--height", "12", "--spp", "1",
+                    "--light-samples", "3", "--out", str(out)], check=True, capture_output=True)
+    s = amalgam.load(path)
+    r = s.render(width=16, height=12, spp=1, light_samples=3)
+    assert np.array_equal(r.image.view(np.uint32), read_pfm(out).view(np.uint32))
+    four = s.render(width=16, height=12, spp=1)  # the file's 4 samples
+    assert r.stats["rays"]["shadow"] < four.stats["rays"]["shadow"]
+    with pytest.raises(ValueError, match="--light-samples"):
+        s.render(width=4, height=4, spp=1, light_samples=0)

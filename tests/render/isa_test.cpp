@@ -27,8 +27,8 @@ FilmState empty_film(const RenderOptions& o) {
 
 void expect_same(const LoadedScene& s, const RenderOptions& o, const std::string& what) {
   FilmState a = empty_film(o), b = empty_film(o);
-  EXPECT_FALSE(detail::render_passes_portable(s, o, a, {}));
-  EXPECT_FALSE(detail::render_passes_avx2(s, o, b, {}));
+  EXPECT_FALSE(detail::render_passes_portable(s, s.env, o, a, {}));
+  EXPECT_FALSE(detail::render_passes_avx2(s, s.env, o, b, {}));
   ASSERT_EQ(a.sum.size(), b.sum.size());
   for (std::size_t i = 0; i < a.sum.size(); ++i) {
     ASSERT_EQ(a.sum[i], b.sum[i]) << what << ", pixel " << i;

@@ -1,6 +1,7 @@
 #include "amalgam/io/scene_json_parts.h"
 
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -34,17 +35,27 @@ Light read_light(const JsonReader& r, const JsonValue& l) {
   const std::string type = r.string(r.require(l, "type"));
   Light light;
   if (type == "point") {
-    r.object(l, {"type", "position", "intensity"});
+    r.object(l, {"type", "position", "intensity", "radius", "samples"});
     light.kind = LightKind::kPoint;
     light.position = r.vec3(r.require(l, "position"));
+    if (auto x = r.find(l, "radius")) light.radius = static_cast<float>(r.positive(*x));
   } else if (type == "directional") {
-    r.object(l, {"type", "direction", "intensity"});
+    r.object(l, {"type", "direction", "intensity", "angle", "samples"});
     light.kind = LightKind::kDirectional;
     light.direction = normalize(r.direction(r.require(l, "direction")));
+    if (auto x = r.find(l, "angle"))
+      light.angle = static_cast<float>(r.number(*x, 1e-4, 90.0, "in degrees, (0, 90]") *
+                                        std::numbers::pi / 180.0);
   } else {
     r.fail(l.ptr + "/type", "expected \"point\" or \"directional\", found \"" + type + "\"");
   }
   light.intensity = r.colour(r.require(l, "intensity"));
+  if (auto x = r.find(l, "samples")) {
+    if (!light.sized())
+      r.fail(x->ptr, type == "point" ? "samples needs a radius (a sized light)"
+                                     : "samples needs an angle (a sized light)");
+    light.samples = static_cast<int>(r.integer(*x, 1, 4096));
+  }
   return light;
 }
 

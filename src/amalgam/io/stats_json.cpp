@@ -23,7 +23,7 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
   const HierarchyInfo info = scene.info();
   json j;
   j["renderer"] = o.renderer == RendererKind::kTraditional ? "traditional" : "scale-sensitive";
-  j["opacity"] = o.opacity == OpacityKind::kStochastic ? "stochastic" : "deterministic";
+  j["opacity"] = std::string(opacity_name(o.opacity));
   const bool ss = o.renderer == RendererKind::kScaleSensitive;
   j["level"] = (ss && o.level) ? json(*o.level) : json(nullptr);
   j["footprint"] = (ss && !o.level) ? json(o.footprint) : json(nullptr);

@@ -85,7 +85,7 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   return s;
 }
 
-void choose_camera(LoadedScene& scene, const CameraChoice& choice) {
+Environment chosen_view(const LoadedScene& scene, const CameraChoice& choice) {
   Camera c = scene.env.camera;
   if (!choice.camera.empty()) {
     const std::string& want = choice.camera;
@@ -125,12 +125,25 @@ void choose_camera(LoadedScene& scene, const CameraChoice& choice) {
   const bool changed = c.position != scene.env.camera.position ||
                        c.look_at != scene.env.camera.look_at || c.up != scene.env.camera.up ||
                        c.vfov_deg != scene.env.camera.vfov_deg;
-  if (!changed) return;
-  scene.env.camera = c;
-  if (scene.default_lights) {
-    const Bbox b = std::visit([](const auto& h) { return h.bounds(h.root()); }, scene.hierarchy);
-    scene.env.lights = default_lights(b, c);
+  Environment env = scene.env;
+  if (choice.light_samples) {
+    if (!(*choice.light_samples >= 1 && *choice.light_samples <= 4096))
+      throw InputError("--light-samples " + std::to_string(*choice.light_samples) +
+                       ": expected an integer in [1, 4096]");
+    for (Light& l : env.lights)
+      if (l.sized()) l.samples = *choice.light_samples;
   }
+  if (!changed) return env;
+  env.camera = c;
+  if (scene.default_lights) {  // (unsized: light_samples does not apply to them)
+    const Bbox b = std::visit([](const auto& h) { return h.bounds(h.root()); }, scene.hierarchy);
+    env.lights = default_lights(b, c);
+  }
+  return env;
+}
+
+void choose_camera(LoadedScene& scene, const CameraChoice& choice) {
+  scene.env = chosen_view(scene, choice);
 }
 
 LoadedScene load_scene(const std::string& spec, const Params& params,

@@ -28,11 +28,12 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
 LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config = {});
 
 /// The view asked for on the command line: one of the scene file's cameras (glTF) by name or
-/// index, then any of its fields replaced.
+/// index, then any of its fields replaced; and the shadow rays per sized light.
 struct CameraChoice {
   std::string camera;  ///< a name, else a 0-based index, of LoadedScene::cameras; empty: default
   std::optional<Vec3> eye, look_at, up;
   std::optional<float> fov_deg;  ///< vertical field of view
+  std::optional<int> light_samples{};  ///< replaces Light::samples of every sized light
 };
 
 /// Applies `choice` to `scene.env.camera`; default lights (LoadedScene::default_lights) follow
@@ -41,6 +42,10 @@ struct CameraChoice {
 /// has), a field of view outside (0, 180) degrees, the eye at the look-at point, or an up
 /// vector along the view direction.
 void choose_camera(LoadedScene& scene, const CameraChoice& choice);
+
+/// The environment `choose_camera` would give the scene, leaving the scene as it is: another
+/// view of one built, baked scene (render's `env` overload, render/render.h). Same errors.
+Environment chosen_view(const LoadedScene& scene, const CameraChoice& choice);
 
 /// Loads `spec`. Throws InputError (one line naming the scene and the problem) on bad input,
 /// including a scene file or mesh that would take more than `config.max_bytes` (checked before

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "amalgam/render/lights.h"
 #include "amalgam/render/shading.h"
 #include "amalgam/traverse/traverse.h"
 
@@ -138,55 +139,85 @@ class Integrator {
     Vec3 sum{};
     const Vec3 wo = -primary.dir;
     if (dot(n, wo) < 0) n = -n;
+    const Vec3 n_shade = n;
     const Vec3 origin = offset_ray_origin(s.p, s.p_error, s.normal);
+    std::uint64_t light_index = 0;
     for (const Light& light : env_.lights) {
-      Vec3 wi;
-      float dist;
-      Vec3 e;
-      if (light.kind == LightKind::kPoint) {
-        const Vec3 d = light.position - origin;
-        dist = length(d);
-        if (!(dist > 0.0f)) continue;
-        wi = d / dist;
-        e = light.intensity / (dist * dist);
-      } else {
-        wi = -normalize(light.direction);
-        dist = kInfinity;
-        e = light.intensity;
-      }
-      Vec3 from = origin;
-      const float f_cos = cloud ? 1.0f : dot(n, wi);  // a cloud has it in its response
-      if (f_cos <= 0.0f) continue;
-      if constexpr (kBaked) {
-        if (dot(s.normal, wi) <= 0.0f) {
-          // Leave the box on the light's side: enter it backwards from beyond.
-          const Bbox box = h_.bounds(*amalgam);
-          const float reach = 2.0f * length(box.hi - box.lo) + 1e-6f;
-          const auto exit = intersect_solid_box(Ray::make(s.p + wi * reach, -wi), box);
-          if (!exit) continue;
-          from = offset_ray_origin(exit->p, exit->p_error, exit->normal);
-          if (light.kind == LightKind::kPoint) {
-            const Vec3 d = light.position - from;
-            dist = length(d);
-            if (!(dist > 0.0f) || dot(d, wi) <= 0.0f) continue;  // light inside the box
-          }
+      const int samples = light.sized() ? std::max(light.samples, 1) : 1;
+      // A sized light's sample points come from their own streams (light, sample) under the
+      // sample's key, apart from the shadow rays' (whose numbering is as without them).
+      const std::uint64_t light_key = hash_combine(key, (std::uint64_t{1} << 62) | light_index++);
+      for (int k = 0; k < samples; ++k) {
+        LightSample ls;
+        if (light.sized()) {
+          Sampler u(hash_combine(light_key, static_cast<std::uint64_t>(k)));
+          const float u1 = u.next(), u2 = u.next();
+          if (!sample_sized_light(light, origin, u1, u2, samples, ls)) break;
+        } else if (light.kind == LightKind::kPoint) {
+          const Vec3 d = light.position - origin;
+          ls.dist = length(d);
+          if (!(ls.dist > 0.0f)) continue;
+          ls.wi = d / ls.dist;
+          ls.e = light.intensity / (ls.dist * ls.dist);
+        } else {
+          ls.wi = -normalize(light.direction);
+          ls.dist = kInfinity;
+          ls.e = light.intensity;
         }
-      } else if (dot(s.normal, wi) <= 0.0f) {
-        continue;
+        sum += one_shadow_ray<kBaked>(primary, s, n_shade, surf, key, stream, amalgam, cloud,
+                                      light, ls, origin, wo);
       }
-      Ray shadow = Ray::make(from, wi, 0.0f, dist * (1.0f - 2.0f * gamma(3)));
-      // The shadow rays of one pixel leave its footprint on the surface and travel to the
-      // light: a parallel beam of the footprint's width toward a directional light, a beam
-      // narrowing to nothing at a point light. (Spreading it like the camera cone made distant
-      // occluders render as amalgams although their shadows span many pixels.)
-      shadow.cone_width = primary.footprint(s.t);
-      shadow.cone_spread =
-          light.kind == LightKind::kPoint ? -shadow.cone_width / std::max(dist, 1e-30f) : 0.0f;
-      const float tr = trav_.transmittance(shadow, hash_combine(key, stream++));
-      if (tr <= 0.0f) continue;
-      sum += (cloud ? cloud_response(surf, wi, wo) : brdf(surf, n, wi, wo)) * e * (f_cos * tr);
     }
     return sum;
+  }
+
+  /// One shadow ray of direct(): light sample `ls` of `light` seen from `origin` (offset from
+  /// the hit `s`); what it brings if unoccluded, times the response toward `wo`.
+  template <bool kBaked>
+  Vec3 one_shadow_ray(const Ray& primary, const SurfaceHit& s, Vec3 n, const Surface& surf,
+                      std::uint64_t key, std::uint64_t& stream, const NodeId* amalgam, bool cloud,
+                      const Light& light, const LightSample& ls, Vec3 origin, Vec3 wo) {
+    const Vec3 wi = ls.wi;
+    float dist = ls.dist;
+    Vec3 from = origin;
+    const float f_cos = cloud ? 1.0f : dot(n, wi);  // a cloud has it in its response
+    if (f_cos <= 0.0f) return {};
+    if constexpr (kBaked) {
+      if (dot(s.normal, wi) <= 0.0f) {
+        // Leave the box on the light's side: enter it backwards from beyond.
+        const Bbox box = h_.bounds(*amalgam);
+        const float reach = 2.0f * length(box.hi - box.lo) + 1e-6f;
+        const auto exit = intersect_solid_box(Ray::make(s.p + wi * reach, -wi), box);
+        if (!exit) return {};
+        from = offset_ray_origin(exit->p, exit->p_error, exit->normal);
+        if (light.kind == LightKind::kPoint) {
+          if (light.sized()) {
+            dist = to_sphere(from, wi, light.position, light.radius);
+            if (!(dist > 0.0f)) return {};  // the light is inside the box
+          } else {
+            const Vec3 d = light.position - from;
+            dist = length(d);
+            if (!(dist > 0.0f) || dot(d, wi) <= 0.0f) return {};  // light inside the box
+          }
+        }
+      }
+    } else if (dot(s.normal, wi) <= 0.0f) {
+      return {};
+    }
+    Ray shadow = Ray::make(from, wi, 0.0f, dist * (1.0f - 2.0f * gamma(3)));
+    // The shadow rays of one pixel leave its footprint on the surface and travel to the
+    // light: a parallel beam of the footprint's width toward a directional light, a beam
+    // narrowing to nothing at a point light. (Spreading it like the camera cone made distant
+    // occluders render as amalgams although their shadows span many pixels.) Toward a sized
+    // light the beam ends as wide as its share of the light (render/lights.h).
+    shadow.cone_width = primary.footprint(s.t);
+    if (light.kind == LightKind::kPoint)
+      shadow.cone_spread = (ls.end_width - shadow.cone_width) / std::max(dist, 1e-30f);
+    else
+      shadow.cone_spread = ls.spread;
+    const float tr = trav_.transmittance(shadow, hash_combine(key, stream++));
+    if (tr <= 0.0f) return {};
+    return (cloud ? cloud_response(surf, wi, wo) : brdf(surf, n, wi, wo)) * ls.e * (f_cos * tr);
   }
 
   const H& h_;

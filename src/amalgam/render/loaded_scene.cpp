@@ -78,6 +78,10 @@ std::uint64_t content_hash(const LoadedScene& scene) {
   for (const Light& l : scene.env.lights) {
     h.add(static_cast<std::uint64_t>(l.kind));
     h.add(l.position), h.add(l.direction), h.add(l.intensity);
+    if (l.sized()) {  // (the hash of every unsized light, as before sizes existed)
+      h.add(l.radius), h.add(l.angle);
+      h.add(static_cast<std::uint64_t>(l.samples));
+    }
   }
   const Camera& c = scene.env.camera;
   h.add(c.position), h.add(c.look_at), h.add(c.up), h.add(c.vfov_deg);

@@ -1,13 +1,29 @@
 #pragma once
 /// \file Renderer options shared by `render`, `trace` and `experiment` (docs/cli.md).
 
+#include <array>
 #include <cstdint>
 #include <optional>
+#include <string_view>
 
 namespace amalgam {
 
 enum class RendererKind : std::uint8_t { kScaleSensitive, kTraditional };
-enum class OpacityKind : std::uint8_t { kStochastic, kDeterministic };
+/// The opacity models (traverse/opacity.h): the paper's two, and kPrefiltered, stochastic for
+/// camera rays and deterministic (prefiltered) attenuation for shadow rays.
+enum class OpacityKind : std::uint8_t { kStochastic, kDeterministic, kPrefiltered };
+/// The names of --opacity, indexed by OpacityKind.
+inline constexpr std::array<std::string_view, 3> kOpacityNames = {"stochastic", "deterministic",
+                                                                   "prefiltered"};
+inline std::string_view opacity_name(OpacityKind k) {
+  return kOpacityNames[static_cast<std::size_t>(k)];
+}
+/// The OpacityKind named `name`, if any.
+inline std::optional<OpacityKind> parse_opacity(std::string_view name) {
+  for (std::size_t i = 0; i < kOpacityNames.size(); ++i)
+    if (kOpacityNames[i] == name) return static_cast<OpacityKind>(i);
+  return std::nullopt;
+}
 /// What finds the hits: amalgam's traversal, or Intel Embree 3 at full detail
 /// (render/embree_tracer.h; only the traditional renderer).
 enum class TracerKind : std::uint8_t { kAmalgam, kEmbree };

@@ -90,6 +90,11 @@ RenderOutput finish(const FilmState& st) {
 
 RenderOutput render(const LoadedScene& scene, const RenderOptions& o, FilmState* resume,
                     const RenderControl& control) {
+  return render(scene, scene.env, o, resume, control);
+}
+
+RenderOutput render(const LoadedScene& scene, const Environment& env, const RenderOptions& o,
+                    FilmState* resume, const RenderControl& control) {
   check_options(scene, o);
   require_amalgam_tracer(o);
   const auto t0 = std::chrono::steady_clock::now();
@@ -99,10 +104,10 @@ RenderOutput render(const LoadedScene& scene, const RenderOptions& o, FilmState*
 
 #if defined(AMALGAM_BUILD_AVX2_COPY)
   const bool interrupted = active_simd() == Simd::kAvx2
-                               ? detail::render_passes_avx2(scene, o, st, control)
-                               : detail::render_passes_portable(scene, o, st, control);
+                               ? detail::render_passes_avx2(scene, env, o, st, control)
+                               : detail::render_passes_portable(scene, env, o, st, control);
 #else  // no AVX2 copy in this build (not GCC, or not x86-64): active_simd() is kPortable
-  const bool interrupted = detail::render_passes_portable(scene, o, st, control);
+  const bool interrupted = detail::render_passes_portable(scene, env, o, st, control);
 #endif
   RenderOutput out = finish(st);
   out.interrupted = interrupted;

@@ -103,6 +103,11 @@ struct RenderControl {
 RenderOutput render(const LoadedScene& scene, const RenderOptions& options,
                     FilmState* resume = nullptr, const RenderControl& control = {});
 
+/// The same with another view of the scene: `env` (camera, lights, background) replaces
+/// scene.env, the hierarchy and its bake are shared (e.g. `chosen_view`, load/load_scene.h).
+RenderOutput render(const LoadedScene& scene, const Environment& env, const RenderOptions& options,
+                    FilmState* resume = nullptr, const RenderControl& control = {});
+
 /// Adds samples s0 .. s1 - 1 to the pixels of `tile` (cut from a film of options.width x
 /// options.height), with the sampling and per-pixel sample order of `render`: rendering every
 /// tile of an image over the same sample ranges gives the bytes of `render` (and its counters,

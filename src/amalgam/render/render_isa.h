@@ -8,11 +8,12 @@
 namespace amalgam::detail {
 
 /// Runs the pass loop of `render` (passes.h) with the integrator and traversal the options
-/// select; returns whether it was interrupted.
-bool render_passes_portable(const LoadedScene& scene, const RenderOptions& o, FilmState& st,
-                            const RenderControl& control);
-bool render_passes_avx2(const LoadedScene& scene, const RenderOptions& o, FilmState& st,
-                        const RenderControl& control);
+/// select, seen with `env` (the scene's or another view of it); returns whether it was
+/// interrupted.
+bool render_passes_portable(const LoadedScene& scene, const Environment& env,
+                            const RenderOptions& o, FilmState& st, const RenderControl& control);
+bool render_passes_avx2(const LoadedScene& scene, const Environment& env, const RenderOptions& o,
+                        FilmState& st, const RenderControl& control);
 
 /// render_tile's pass (passes.h, render_tile_passes); returns whether it was interrupted.
 bool render_tile_portable(const LoadedScene& scene, const RenderOptions& o, FilmTile& tile, int s0,

@@ -19,10 +19,18 @@ auto dispatch(const LoadedScene& scene, const RenderOptions& o, F&& f) {
       [&](const auto& h) {
         auto with_lod = [&](auto lod) {
           auto with_opacity = [&](auto op) {
-            if (o.sorted) return f(h, lod, op, SortedOrder{});
-            return f(h, lod, op, StoredOrder{});
+            // The traditional renderer renders no amalgam: one opacity model serves every
+            // --opacity (fewer instantiations; the same images and counts).
+            if constexpr (std::is_same_v<decltype(lod), TraditionalLod>) {
+              if (o.sorted) return f(h, lod, StochasticOpacity{}, SortedOrder{});
+              return f(h, lod, StochasticOpacity{}, StoredOrder{});
+            } else {
+              if (o.sorted) return f(h, lod, op, SortedOrder{});
+              return f(h, lod, op, StoredOrder{});
+            }
           };
           if (o.opacity == OpacityKind::kStochastic) return with_opacity(StochasticOpacity{});
+          if (o.opacity == OpacityKind::kPrefiltered) return with_opacity(PrefilteredOpacity{});
           return with_opacity(DeterministicOpacity{});
         };
         if (o.renderer == RendererKind::kTraditional) return with_lod(TraditionalLod{});
@@ -37,13 +45,14 @@ AMALGAM_ISA_END
 
 namespace detail {
 
-bool AMALGAM_ISA_SUFFIXED(render_passes)(const LoadedScene& scene, const RenderOptions& o,
-                                         FilmState& st, const RenderControl& control) {
+bool AMALGAM_ISA_SUFFIXED(render_passes)(const LoadedScene& scene, const Environment& env,
+                                         const RenderOptions& o, FilmState& st,
+                                         const RenderControl& control) {
   bool interrupted = false;
   dispatch(scene, o, [&](const auto& h, auto lod, auto op, auto order) {
     using I = Integrator<std::decay_t<decltype(h)>, decltype(lod), decltype(op), decltype(order)>;
-    interrupted = render_passes(scene.env.camera, o, st, control,
-                                [&](Counters& c) { return I(h, scene.env, lod, c); });
+    interrupted =
+        render_passes(env.camera, o, st, control, [&](Counters& c) { return I(h, env, lod, c); });
   });
   return interrupted;
 }

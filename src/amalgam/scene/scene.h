@@ -51,12 +51,22 @@ Bbox bounds(const Primitive& prim);
 enum class LightKind : std::uint8_t { kPoint, kDirectional };
 
 /// A point light (position, intensity in W/sr) or a directional light (direction the light
-/// travels, irradiance).
+/// travels, irradiance). Either may have a size, which makes its shadows soft (render/lights.h):
+/// a point light with `radius` > 0 is a sphere of that radius, its surface of uniform radiance
+/// intensity / (pi radius^2) (the same intensity seen from afar); a directional light with
+/// `angle` > 0 comes from a disc of that angular diameter (radians) about -direction, the
+/// same irradiance in all. A sized light is sampled with `samples` shadow rays per shading
+/// point. Lights are not visible to camera rays.
 struct Light {
   LightKind kind = LightKind::kPoint;
   Vec3 position{};
   Vec3 direction{0, -1, 0};
   Vec3 intensity{1, 1, 1};
+  float radius = 0.0f;  ///< point lights: sphere radius (0: a point)
+  float angle = 0.0f;   ///< directional lights: angular diameter in radians (0: one direction)
+  int samples = 1;      ///< shadow rays per shading point when the light has a size
+
+  bool sized() const { return kind == LightKind::kPoint ? radius > 0.0f : angle > 0.0f; }
 };
 
 /// A pinhole camera.

@@ -104,7 +104,7 @@ struct RayState {
   /// what that does to the ray, with the amalgam's opacity in the ray's direction.
   void render_amalgam(NodeId id, int level, const Bbox& b, float t) {
     const float a = directional_opacity(h.appearance(id), b, ray.dir);
-    switch (opacity.effect(a, key, id)) {
+    switch (opacity.effect(a, key, id, any_hit)) {
       case AmalgamEffect::kPass:
         return;
       case AmalgamEffect::kBlend:

@@ -1,0 +1,93 @@
+#pragma once
+/// \file Sampling a light from a shading point: the direction and distance of one shadow ray,
+/// the light it brings if unoccluded, and the width its cone should reach at the light.
+///
+/// A point or directional light without size gives one sample, exactly as it always has. A
+/// sized light (scene/scene.h) is sampled by solid angle, uniformly over the cone of
+/// directions under which it is seen; with n samples each carries 1/n of it:
+/// - sphere (centre c, radius r, radiance L = I / (pi r^2)), seen from p at distance d > r
+///   within the cone of half-angle asin(r / d): weight L * 2 pi (1 - cos) / n, the exact
+///   irradiance of a uniform sphere (I / d^2 for a point facing it) in expectation;
+/// - disc of angular diameter a about -direction (a sun): weight E / n.
+/// Each shadow ray answers for 1/n of the light's solid angle, so its cone widens from the
+/// pixel's footprint to the light's width / sqrt(n) at the light: the shadow rays of a soft
+/// shadow see occluders as coarse as the penumbra they blur.
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "amalgam/geometry/ray.h"
+#include "amalgam/scene/scene.h"
+#include "amalgam/util/isa.h"
+
+namespace amalgam {
+AMALGAM_ISA_BEGIN
+
+struct LightSample {
+  Vec3 wi;           ///< unit direction toward the light
+  float dist = 0.0f;  ///< distance to the light along wi (infinity: directional)
+  Vec3 e;            ///< light arriving (irradiance normal to wi), this sample's share
+  float end_width = 0.0f;  ///< sphere: the width the shadow ray's cone should have at it
+  float spread = 0.0f;     ///< disc (directional): the cone's widening per unit distance
+};
+
+/// An orthonormal basis (s, t) perpendicular to the unit vector `w`.
+inline void basis(Vec3 w, Vec3& s, Vec3& t) {
+  const float sign = std::copysign(1.0f, w.z);
+  const float a = -1.0f / (sign + w.z), b = w.x * w.y * a;
+  s = {1.0f + sign * w.x * w.x * a, sign * b, -sign * w.x};
+  t = {b, sign + w.y * w.y * a, -w.y};
+}
+
+/// A direction uniformly distributed in the cone of half-angle acos(cos_max) about unit `w`.
+inline Vec3 in_cone(Vec3 w, float cos_max, float u1, float u2) {
+  const float c = 1.0f - u1 * (1.0f - cos_max);
+  const float s = std::sqrt(std::max(0.0f, 1.0f - c * c));
+  const float phi = 2.0f * std::numbers::pi_v<float> * u2;
+  Vec3 a, b;
+  basis(w, a, b);
+  return normalize(a * (s * std::cos(phi)) + b * (s * std::sin(phi)) + w * c);
+}
+
+/// Distance along unit `dir` from `p` to the near surface of the sphere (c, r); negative when
+/// the line misses it.
+inline float to_sphere(Vec3 p, Vec3 dir, Vec3 c, float r) {
+  const Vec3 oc = c - p;
+  const float tc = dot(oc, dir);
+  const float h2 = dot(oc, oc) - tc * tc;
+  const float r2 = r * r;
+  if (h2 > r2) return -1.0f;
+  return tc - std::sqrt(r2 - h2);
+}
+
+/// Sample `u1`, `u2` (in [0, 1)) of a sized light seen from `p`, one of `n`. False when `p` is
+/// inside a sphere light (it is not lit then).
+inline bool sample_sized_light(const Light& l, Vec3 p, float u1, float u2, int n, LightSample& s) {
+  constexpr float pi = std::numbers::pi_v<float>;
+  const float share = 1.0f / static_cast<float>(std::max(n, 1));
+  const float root = std::sqrt(share);
+  if (l.kind == LightKind::kDirectional) {
+    const float half = 0.5f * l.angle;
+    s.wi = in_cone(-normalize(l.direction), std::cos(half), u1, u2);
+    s.dist = kInfinity;
+    s.e = l.intensity * share;
+    s.spread = 2.0f * std::tan(half) * root;
+    return true;
+  }
+  const Vec3 oc = l.position - p;
+  const float d = length(oc);
+  if (!(d > l.radius)) return false;
+  const float sin_max = l.radius / d;
+  const float cos_max = std::sqrt(std::max(0.0f, 1.0f - sin_max * sin_max));
+  s.wi = in_cone(oc / d, cos_max, u1, u2);
+  s.dist = std::max(0.0f, to_sphere(p, s.wi, l.position, l.radius));
+  if (!(s.dist > 0.0f)) s.dist = d - l.radius;  // rounding at the cone's rim
+  const float radiance_scale = 1.0f / (pi * l.radius * l.radius);
+  s.e = l.intensity * (radiance_scale * 2.0f * pi * (1.0f - cos_max) * share);
+  s.end_width = 2.0f * l.radius * root;
+  return true;
+}
+
+AMALGAM_ISA_END
+}  // namespace amalgam
