@@ -472,7 +472,6 @@ RenderOutput render_root(const TileRenderer& render_tile, const RenderOptions& o
           w.tile = -1;
         }
         if (!busy) std::this_thread::sleep_for(std::chrono::microseconds(100));
-        // Rank 0's thread may have stopped (all tiles handed out); nothing else to wait for.
       }
     } catch (...) {
       failure = std::current_exception();
@@ -534,6 +533,7 @@ bool release() {
       MPI_Status status;
       if (!wait_message(r, status, deadline)) {
         all = false;
+        w.lost = true;  // its last message may never be received: do not wait for it below
         std::cerr << "amalgam: rank " << r << " did not answer within " << g_dispatch.timeout
                   << " s\n";
         continue;
