@@ -32,7 +32,7 @@ struct CommonOptions {
   CLI::Option* opacity_option = nullptr;
   CLI::Option* order_option = nullptr;
   std::string camera, eye, look_at, up, fov;  ///< the view options, as given
-  int light_samples = 0;                        ///< --light-samples (0: not given)
+  int light_samples = 0;                      ///< --light-samples (0: not given)
   CameraChoice view;                          ///< set by finish()
 
   /// Registers SCENE, --set and the renderer options of docs/cli.md on `app`.
