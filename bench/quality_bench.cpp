@@ -68,6 +68,8 @@ struct Args {
   int ref_max_spp = 1024, ref_batches = 8, oracle_rays = 64, oracle_spp = 2, oracle_runs = 2;
   double ref_se = 0.002;
   bool quick = false, no_embree = false, oracle_box = false;
+  std::string opacity = "stochastic";  ///< of the scale-sensitive curves
+  int light_samples = 0;               ///< shadow rays per sized light in every curve (0: the scene's)
 };
 
 std::string loadavg() {
@@ -242,6 +244,10 @@ Run run_once(const Args& a, const std::string& kind, float k, int spp, std::uint
   RenderOptions o = base_options(a);
   o.spp = spp, o.seed = seed;
   if (k > 0) o.footprint = k;
+  if (kind == "scale-sensitive") o.opacity = *parse_opacity(a.opacity);
+  if (a.light_samples > 0)
+    for (Light& l : s.env.lights)
+      if (l.sized()) l.samples = a.light_samples;
   Run r;
   if (kind == "embree") {
     const auto& h = std::get<InstancedHierarchy>(s.hierarchy);
@@ -333,6 +339,12 @@ int run(int argc, char** argv) {
   app.add_option("--runs", a.runs, "runs (seeds) per point: median time, bias/variance split");
   app.add_option("--spps", a.spps, "samples per pixel of the curves");
   app.add_option("--footprints", a.ks, "footprints K of the scale-sensitive curves");
+  app.add_option("--opacity", a.opacity, "opacity model of the scale-sensitive curves")
+      ->check(CLI::IsMember({"stochastic", "deterministic", "prefiltered"}));
+  app.add_option("--light-samples", a.light_samples,
+                 "shadow rays per sized light in every measured curve (default: the scene's; "
+                 "the reference keeps the scene's)")
+      ->check(CLI::Range(0, 4096));
   app.add_option("--oracle-footprints", a.oracle_ks, "footprints K of the oracle (empty: none)");
   app.add_option("--oracle-rays", a.oracle_rays, "full-detail rays per oracle estimate");
   app.add_option("--oracle-spp", a.oracle_spp, "samples per pixel of the oracle renders");
@@ -360,6 +372,7 @@ int run(int argc, char** argv) {
   result["scene"] = a.scene, result["view"] = a.view;
   result["width"] = a.width, result["height"] = a.height, result["threads"] = a.threads;
   result["runs"] = a.runs;
+  result["opacity"] = a.opacity, result["light_samples"] = a.light_samples;
   result["loadavg_start"] = loadavg();
   result["embree"] = "Embree 3, RTC_BUILD_QUALITY_MEDIUM (its default), RTC_SCENE_FLAG_NONE";
 

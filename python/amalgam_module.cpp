@@ -383,9 +383,13 @@ py::object experiment(const std::string& name, bool quick, int threads, bool fra
   if (threads < 0)
     throw InputError("--threads " + std::to_string(threads) + ": expected an integer >= 0");
   experiments::ExperimentResult r;
+  experiments::Config config;
+  config.quick = quick;
+  config.threads = threads;
+  config.load = [](const std::string& path) { return load_scene(path, Params(path)); };
   {
     py::gil_scoped_release nogil;
-    r = experiments::run(name, experiments::Config{quick, threads});
+    r = experiments::run(name, config);
   }
   py::list rows;
   for (const auto& row : r.table.rows) {

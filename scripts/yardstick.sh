@@ -41,6 +41,7 @@ fi
 
 dirs=()
 command="scripts/yardstick.sh"
+[[ "$SCENE" != scenes/field.json ]] && command="SCENE=$SCENE DOC=$DOC DOCS=$DOCS VIEWS=\"$VIEWS\" $command"
 [[ -n "${BENCH_ARGS:-}" ]] && command+=" (BENCH_ARGS=\"$BENCH_ARGS\")"
 for view in $VIEWS; do
   echo "yardstick: $view view" >&2

@@ -143,7 +143,10 @@ def section(res, img_rel, img_dir):
     out = [f"### {v} view", ""]
     out.append(
         f"Scene `{res['scene']}`, {res['width']} x {res['height']}, {res['threads']} threads, "
-        f"{res['runs']} runs (seeds) per point. Machine load average (1/5/15 min) at the start "
+        f"scale-sensitive opacity {res.get('opacity', 'stochastic')}, "
+        + (f"{res['light_samples']} shadow ray(s) per sized light in every curve, "
+           if res.get("light_samples") else "")
+        + f"{res['runs']} runs (seeds) per point. Machine load average (1/5/15 min) at the start "
         f"{res['loadavg_start']}, at the end {res['loadavg_end']}. Reference: amalgam "
         f"traditional, stratified, {ref['spp']} spp, mean per-pixel standard error "
         f"{ref['mean_standard_error']:.4f}"

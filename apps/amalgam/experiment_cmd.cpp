@@ -2,14 +2,17 @@
 /// sweeps (amalgam/analysis/experiments.h) and writes DIR/<name>.csv, DIR/<name>.gp and
 /// DIR/<name>.png (gnuplot) and DIR/report.md.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
 
 #include "amalgam/analysis/experiments.h"
+#include "amalgam/load/load_scene.h"
 #include "amalgam/util/atomic_file.h"
 #include "common.h"
 #if defined(AMALGAM_HAVE_MPI)
@@ -157,41 +160,105 @@ std::string section(const ex::ExperimentResult& r, bool plotted, bool gnuplot) {
   return o.str();
 }
 
-/// What the report and the files need of one experiment, as text.
+/// Every statement of the paper with the verdict its checks give (ex::verdict_of), computed
+/// from the checks of the experiments run; statements no experiment run checks say so.
+std::string statements_table(const std::vector<ex::Check>& checks,
+                             const std::vector<std::string>& ran) {
+  std::ostringstream o;
+  o << "Every equation and statement of the paper, in its order, with the verdict computed from "
+       "the checks that bear on it (holds: every check passes; holds with correction: the "
+       "printed form is refuted by a check and the corrected form passes; does not hold: a "
+       "check of the statement fails). Hand derivations of each: "
+       "`docs/paper-derivations.md` of the repository.\n\n";
+  o << "| statement | the paper says | verdict | checks passed | experiment |\n"
+       "|---|---|---|---|---|\n";
+  for (const ex::Statement& st : ex::statements()) {
+    int total = 0, passed = 0;
+    for (const auto& c : checks)
+      if (c.statement == st.id) ++total, passed += c.passed();
+    bool run = false;
+    for (const auto& e : st.experiments) run |= std::find(ran.begin(), ran.end(), e) != ran.end();
+    std::string verdict;
+    if (const auto v = ex::verdict_of(checks, st.id))
+      verdict = ex::to_string(*v);
+    else if (st.experiments.empty())
+      verdict = "not measured (derived by hand only)";
+    else
+      verdict = run ? "measured, not checked (see the experiment)" : "not run";
+    o << "| " << st.id << " | " << st.says << " | " << verdict << " | ";
+    if (total > 0)
+      o << passed << "/" << total;
+    else
+      o << "-";
+    o << " | ";
+    if (st.experiments.empty()) o << "-";
+    for (std::size_t i = 0; i < st.experiments.size(); ++i)
+      o << (i ? ", " : "") << "[" << st.experiments[i] << "](#" << st.experiments[i] << ")";
+    o << " |\n";
+  }
+  return o.str();
+}
+
+/// What the report and the files need of one experiment, as text and checks.
 struct Computed {
   std::string csv, gp, section_plotted, section_unplotted, verdict, seconds;
-  int passed = 0, checks = 0;
+  int passed = 0;
+  std::vector<ex::Check> checks;
 
-  /// Length-prefixed fields (a message between ranks).
+  /// Length-prefixed fields, numbers as the bits of their doubles (a message between ranks).
   std::string pack() const {
     std::string out;
+    auto text = [&](const std::string& f) { out += std::to_string(f.size()) + ":" + f; };
+    auto number = [&](double v) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &v, sizeof bits);
+      text(std::to_string(bits));
+    };
     for (const std::string* f :
-         {&csv, &gp, &section_plotted, &section_unplotted, &verdict, &seconds}) {
-      out += std::to_string(f->size()) + ":";
-      out += *f;
+         {&csv, &gp, &section_plotted, &section_unplotted, &verdict, &seconds})
+      text(*f);
+    text(std::to_string(passed));
+    text(std::to_string(checks.size()));
+    for (const ex::Check& c : checks) {
+      text(c.what);
+      text(c.statement);
+      text(std::to_string(static_cast<int>(c.role)));
+      for (double v : {c.measured, c.predicted, c.tolerance}) number(v);
     }
-    out += std::to_string(passed) + ":" + std::to_string(checks) + ":";
     return out;
   }
   static Computed unpack(const std::string& in) {
     Computed c;
     std::size_t at = 0;
-    auto number = [&] {
+    auto text = [&] {
       const std::size_t colon = in.find(':', at);
       if (colon == std::string::npos) throw RuntimeError("experiment: a malformed result");
-      const std::size_t v = std::stoul(in.substr(at, colon - at));
-      at = colon + 1;
+      const std::size_t len = std::stoul(in.substr(at, colon - at));
+      if (colon + 1 + len > in.size()) throw RuntimeError("experiment: a malformed result");
+      at = colon + 1 + len;
+      return in.substr(colon + 1, len);
+    };
+    auto number = [&] {
+      const std::uint64_t bits = std::stoull(text());
+      double v;
+      std::memcpy(&v, &bits, sizeof v);
       return v;
     };
     for (std::string* f :
-         {&c.csv, &c.gp, &c.section_plotted, &c.section_unplotted, &c.verdict, &c.seconds}) {
-      const std::size_t len = number();
-      if (at + len > in.size()) throw RuntimeError("experiment: a malformed result");
-      *f = in.substr(at, len);
-      at += len;
+         {&c.csv, &c.gp, &c.section_plotted, &c.section_unplotted, &c.verdict, &c.seconds})
+      *f = text();
+    c.passed = std::stoi(text());
+    const std::size_t n = std::stoul(text());
+    for (std::size_t i = 0; i < n; ++i) {
+      ex::Check k;
+      k.what = text();
+      k.statement = text();
+      k.role = static_cast<ex::Role>(std::stoi(text()));
+      k.measured = number();
+      k.predicted = number();
+      k.tolerance = number();
+      c.checks.push_back(std::move(k));
     }
-    c.passed = static_cast<int>(number());
-    c.checks = static_cast<int>(number());
     return c;
   }
 };
@@ -248,48 +315,55 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
   ex::Config config;
   config.quick = quick;
   config.threads = threads;
+  config.load = [](const std::string& path) { return load_scene(path, Params(path)); };
 
   std::ostringstream report;
   report << "# Thompson & Fussell (1991), \"Time Costs of Ray Tracing with Amalgams\": measured\n\n"
          << "Generated by `amalgam experiment " << name << " --out " << out_dir
          << (quick ? " --quick" : "") << "`. Every measured figure comes from rays traced "
-         << "through the renderer (builtin:line, builtin:poisson, builtin:prisms), except the "
-         << "2D searches of linear-cost; predictions come from `src/amalgam/analysis/formulas.h`."
+         << "through the renderer (builtin:line, builtin:poisson, builtin:prisms; noise-baked and "
+         << "premise also load the Wuson mesh of assimp-testmodels and `scenes/field.json`, "
+         << "relative to the working directory: run from the repository root), except the "
+         << "2D searches of linear-cost; predictions come from `src/amalgam/analysis/formulas.h`. "
+         << "Wall times depend on the machine and its load and are reported, never checked."
          << (gnuplot ? "" : " **gnuplot was not found on PATH: no plots were made.**") << "\n\n";
-  report << "| experiment | verdict | checks passed | seconds |\n|---|---|---|---|\n";
-  std::ostringstream body;
+  std::ostringstream summary, body;
+  summary << "| experiment | verdict | checks passed | seconds |\n|---|---|---|---|\n";
+  std::vector<ex::Check> all_checks;  // of every experiment run, for the statements table
+  std::vector<std::string> ran;
   int failures = 0;
   // One experiment's outputs as text: computed here or, under mpirun, on any rank
   // (mpi::spread), then written by this process (rank 0) in report order.
   auto compute = [&](const std::string& n) {
     const ex::ExperimentResult r = ex::run(n, config);
-    int passed = 0;
-    for (const auto& c : r.checks) passed += c.passed();
     Computed c;
+    for (const auto& k : r.checks) c.passed += k.passed();
     c.csv = csv(r.table);
     c.gp = gnuplot_script(r, n + ".csv", n + ".png.tmp");
     c.section_plotted = section(r, true, gnuplot);
     c.section_unplotted = section(r, false, gnuplot);
     c.verdict = ex::to_string(r.verdict);
-    c.passed = passed;
-    c.checks = static_cast<int>(r.checks.size());
     c.seconds = ex::fmt(r.seconds);
+    c.checks = r.checks;
     return c;
   };
   auto emit = [&](const std::string& n, const Computed& c) {
     write_file_atomic((dir / (n + ".csv")).string(), c.csv);
     write_file_atomic((dir / (n + ".gp")).string(), c.gp);
     const bool plotted = gnuplot && plot(dir, n);
-    failures += c.checks - c.passed;
-    std::cerr << " " << c.verdict << ", " << c.passed << "/" << c.checks << " checks, " << c.seconds
-              << " s\n";
-    std::cout << n << ": " << c.verdict << " (" << c.passed << "/" << c.checks << " checks)\n";
-    report << "| [" << n << "](#" << n << ") | " << c.verdict << " | " << c.passed << "/"
-           << c.checks << " | " << c.seconds << " |\n";
+    failures += static_cast<int>(c.checks.size()) - c.passed;
+    std::cerr << " " << c.verdict << ", " << c.passed << "/" << c.checks.size() << " checks, "
+              << c.seconds << " s\n";
+    std::cout << n << ": " << c.verdict << " (" << c.passed << "/" << c.checks.size()
+              << " checks)\n";
+    summary << "| [" << n << "](#" << n << ") | " << c.verdict << " | " << c.passed << "/"
+            << c.checks.size() << " | " << c.seconds << " |\n";
     body << (plotted ? c.section_plotted : c.section_unplotted);
+    all_checks.insert(all_checks.end(), c.checks.begin(), c.checks.end());
+    ran.push_back(n);
   };
 #if defined(AMALGAM_HAVE_MPI)
-  if (mpi::parallel()) {
+  if (parallel) {
     mpi::spread(
         static_cast<int>(todo.size()),
         [&](int i) { return compute(todo[static_cast<std::size_t>(i)]).pack(); },
@@ -298,7 +372,7 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
           std::cerr << "amalgam: experiment " << n << " ..." << std::flush;
           emit(n, Computed::unpack(packed));
         });
-    if (mpi::rank() != 0) return 0;
+    if (!root) return 0;
   } else
 #endif
   {
@@ -307,7 +381,7 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
       emit(n, compute(n));
     }
   }
-  report << "\n" << body.str();
+  report << statements_table(all_checks, ran) << "\n" << summary.str() << "\n" << body.str();
   write_file_atomic((dir / "report.md").string(), report.str());
   std::cout << "report: " << (dir / "report.md").string() << "\n";
   (void)failures;

@@ -53,6 +53,23 @@ TEST(Cli, TraceLineTraditionalIsTheWorstCase) {
   EXPECT_TRUE(j["level"].is_null());
 }
 
+// `traversed` is the paper's count of objects traversed: on builtin:poisson with p huge the
+// first amalgam of level 3 stops the ray, so it reaches the left edge and that amalgam,
+// 3 + 1 = Eq. 4 with i = 1, while it tests both children of the 3 nodes it enters, 1 + 2 * 3.
+// In the worst case (builtin:line, traditional) both counts are C_t0.
+TEST(Cli, TraceReportsObjectsTraversedAsThePaperCounts) {
+  CliRun r = run("trace builtin:poisson --set p=1e12 --set depth=6 --level 3");
+  ASSERT_EQ(r.status, 0);
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["traversed"]["primary"], 4);
+  EXPECT_EQ(j["tests"]["primary"], 7);
+  r = run("trace builtin:line --set n=3 --set depth=6 --renderer traditional");
+  ASSERT_EQ(r.status, 0);
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["traversed"]["primary"], 1093);
+  EXPECT_EQ(j["traversed"]["shadow"], 1093);
+}
+
 TEST(Cli, TraceFootprintIsThatOfAPixelOfWidthByHeight) {
   auto trace = [](const std::string& size) {
     const CliRun r = run("trace builtin:prisms" + size);

@@ -140,5 +140,34 @@ TEST(ScaleSensitiveLine, LightsScaleShadowCost) {
   }
 }
 
+// The paper's counting of "objects traversed" (Counters::traversed_of): children reached in
+// sorted order until the first hit. Where every amalgam of level l1 lets the ray through
+// (builtin:line, alpha 0: nothing stops it) every object above and on l1 is reached: C_s0
+// (Eq. 1), the same as the intersection tests. Where the first amalgam stops the ray
+// (builtin:poisson with p/b huge) only the left edge and that amalgam are reached,
+// l1 + 1 = Eq. 4 with i = 1, while the renderer tests all n children of each entered node,
+// 1 + n l1.
+TEST(ObjectsTraversed, WorstCaseIsCs0AndFirstHitIsEq4) {
+  for (int n : {2, 3, 8}) {
+    for (int l1 = 1; l1 <= (n == 8 ? 3 : 6); ++l1) {
+      RenderOptions o;
+      o.level = l1;
+      const TraceOutput w = trace_centre(line(n, l1 + 1), o);
+      EXPECT_EQ(w.counters.traversed_of(RayKind::kPrimary), geometric_sum(n, l1))
+          << "n=" << n << " l1=" << l1;
+      Params p("builtin:poisson");
+      p.set("n", std::to_string(n));
+      p.set("depth", std::to_string(l1 + 1));
+      p.set("p", "1e12");
+      const TraceOutput f = trace_centre(load_scene("builtin:poisson", p), o);
+      EXPECT_EQ(f.hit.kind, TraceHit::Kind::kAmalgam);
+      EXPECT_EQ(f.counters.traversed_of(RayKind::kPrimary), std::uint64_t(l1 + 1))
+          << "n=" << n << " l1=" << l1;
+      EXPECT_EQ(f.counters.tests_of(RayKind::kPrimary), std::uint64_t(1 + n * l1))
+          << "n=" << n << " l1=" << l1;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace amalgam

@@ -65,6 +65,7 @@ std::vector<Ray> random_rays(const Bbox& box, int n, std::uint32_t seed) {
 void expect_same_counts(const Counters& a, const Counters& b, const std::string& what) {
   EXPECT_EQ(a.tests, b.tests) << what;
   EXPECT_EQ(a.by_level, b.by_level) << what;
+  EXPECT_EQ(a.reached, b.reached) << what << ": objects traversed (the paper's counting)";
   EXPECT_EQ(a.rays, b.rays) << what;
 }
 

@@ -1,5 +1,6 @@
 #include "amalgam/analysis/experiments.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -26,8 +27,32 @@ const char* to_string(Verdict v) {
       return "holds with correction";
     case Verdict::kDoesNotHold:
       return "does not hold";
+    case Verdict::kNotMeasured:
+      return "not checked";
   }
   return "?";
+}
+
+Verdict verdict_of(const std::vector<Check>& checks) {
+  if (checks.empty()) return Verdict::kNotMeasured;
+  bool corrected = false;
+  for (const Check& c : checks) {
+    if (c.role == Role::kSupports && !c.passed()) return Verdict::kDoesNotHold;
+    if (c.role == Role::kRefutesPrinted && c.passed()) corrected = true;
+  }
+  return corrected ? Verdict::kHoldsWithCorrection : Verdict::kHolds;
+}
+
+std::optional<Verdict> verdict_of(const std::vector<Check>& checks, const std::string& id) {
+  std::vector<Check> mine;
+  for (const Check& c : checks)
+    if (c.statement == id) mine.push_back(c);
+  if (mine.empty()) return std::nullopt;
+  return verdict_of(mine);
+}
+
+double predict(const Config& config, const std::string& name, double value) {
+  return config.perturb ? config.perturb(name, value) : value;
 }
 
 const std::vector<std::string>& names() {
@@ -35,11 +60,16 @@ const std::vector<std::string>& names() {
                                              "worst-stochastic",
                                              "worst-deterministic",
                                              "expected",
+                                             "traversed",
                                              "failed-tests",
                                              "lights",
                                              "noise",
+                                             "noise-baked",
                                              "more-levels",
-                                             "linear-cost"};
+                                             "linear-cost",
+                                             "p-vs-P",
+                                             "sorting",
+                                             "premise"};
   return n;
 }
 
@@ -50,16 +80,22 @@ ExperimentResult run(const std::string& name, const Config& config) {
       {"worst-stochastic", worst_stochastic},
       {"worst-deterministic", worst_deterministic},
       {"expected", expected},
+      {"traversed", traversed},
       {"failed-tests", failed_tests},
       {"lights", lights},
       {"noise", noise},
+      {"noise-baked", noise_baked},
       {"more-levels", more_levels},
-      {"linear-cost", linear_cost}};
+      {"linear-cost", linear_cost},
+      {"p-vs-P", p_vs_primitives},
+      {"sorting", sorting},
+      {"premise", premise}};
   for (const auto& [n, f] : table) {
     if (n != name) continue;
     const auto t0 = std::chrono::steady_clock::now();
     ExperimentResult r = f(config);
     r.name = name;
+    r.verdict = verdict_of(r.checks);
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return r;
   }
@@ -82,6 +118,19 @@ LinearFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {
   f.b = sxx > 0 ? sxy / sxx : 0;
   f.a = my - f.b * mx;
   f.r2 = (sxx > 0 && syy > 0) ? (sxy * sxy) / (sxx * syy) : 1.0;
+  if (n >= 3 && sxx > 0) {
+    // Residual variance s^2 = (syy - b sxy)/(n - 2); se(b) = s / sqrt(sxx).
+    const double s2 = std::max(0.0, syy - f.b * sxy) / double(n - 2);
+    f.se_b = std::sqrt(s2 / sxx);
+    // Two-sided 97.5% quantiles of Student's t for 1..30 degrees of freedom; beyond, the
+    // expansion 1.96 + 2.5/df (within 0.2% of the true quantile for df > 30).
+    static const double t975[30] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306,
+                                    2.262,  2.228, 2.201, 2.179, 2.160, 2.145, 2.131, 2.120,
+                                    2.110,  2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064,
+                                    2.060,  2.056, 2.052, 2.048, 2.045, 2.042};
+    const std::size_t df = n - 2;
+    f.ci95_b = f.se_b * (df <= 30 ? t975[df - 1] : 1.96 + 2.5 / double(df));
+  }
   return f;
 }
 

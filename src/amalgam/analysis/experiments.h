@@ -11,8 +11,11 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "amalgam/render/loaded_scene.h"
 
 namespace amalgam::experiments {
 
@@ -52,15 +55,56 @@ struct Panel {
   std::vector<Series> series;
 };
 
+/// What a check says about the paper. kSupports: the measurement agrees with the paper's
+/// statement (or with our correction of a printed formula) -- if it fails, the statement does
+/// not hold. kRefutesPrinted: the measurement disagrees with a formula or claim as printed --
+/// if it passes, the statement holds only with a correction.
+enum class Role { kSupports, kRefutesPrinted };
+
 /// A measured figure checked against a prediction: |measured - predicted| <= tolerance.
+/// `statement` names the paper statement it bears on (an id of statements(), e.g. "Eq. 12";
+/// empty: the experiment's own claim).
 struct Check {
+  Check() = default;
+  Check(std::string what_, double measured_, double predicted_, double tolerance_,
+        Role role_ = Role::kSupports, std::string statement_ = "")
+      : what(std::move(what_)),
+        measured(measured_),
+        predicted(predicted_),
+        tolerance(tolerance_),
+        role(role_),
+        statement(std::move(statement_)) {}
   std::string what;
   double measured = 0, predicted = 0, tolerance = 0;
+  Role role = Role::kSupports;
+  std::string statement;
   bool passed() const;
 };
 
-enum class Verdict { kHolds, kHoldsWithCorrection, kDoesNotHold };
+/// kNotMeasured ("not checked"): no check was made (a claim about wall time only, or the scenes
+/// an experiment needs could not be loaded).
+enum class Verdict { kHolds, kHoldsWithCorrection, kDoesNotHold, kNotMeasured };
 const char* to_string(Verdict v);
+
+/// The verdict that follows from checks (never written by hand): not measured if there are
+/// none; does not hold if a kSupports check fails; else holds with correction if a
+/// kRefutesPrinted check passes; else holds.
+Verdict verdict_of(const std::vector<Check>& checks);
+
+/// The verdict of the checks bearing on one paper statement (Check::statement == id), or
+/// std::nullopt when none does.
+std::optional<Verdict> verdict_of(const std::vector<Check>& checks, const std::string& id);
+
+/// One statement of the paper (an equation or a claim in words) and where it is checked.
+struct Statement {
+  std::string id;                        ///< "Eq. 12", "Sec. noise", ...
+  std::string says;                      ///< what the paper says, in brief
+  std::vector<std::string> experiments;  ///< those whose checks bear on it (none: derived only)
+};
+
+/// Every equation and statement of the paper, in the paper's order (the report's first table;
+/// hand derivations of each are in docs/paper-derivations.md).
+const std::vector<Statement>& statements();
 
 struct ExperimentResult {
   std::string name;                          ///< e.g. "worst-traditional"
@@ -72,7 +116,7 @@ struct ExperimentResult {
   std::vector<std::size_t> summary_rows;     ///< rows shown in the report (empty: up to 12)
   std::vector<Panel> panels;                 ///< the PNG (panels side by side)
   std::vector<Check> checks;
-  Verdict verdict = Verdict::kHolds;
+  Verdict verdict = Verdict::kHolds;  ///< set by run() from `checks` (verdict_of)
   std::string findings;  ///< measured key figures and the reasoning for the verdict (markdown)
   double seconds = 0;
 };
@@ -80,7 +124,18 @@ struct ExperimentResult {
 struct Config {
   bool quick = false;
   int threads = 0;  ///< 0: all cores
+  /// Test hook: every prediction an experiment takes from a named formula passes through
+  /// perturb(formula name, value) (see predict()); a deliberately wrong formula injected here
+  /// must turn the verdict (tests/analysis/experiments_test.cpp). Empty: predictions as computed.
+  std::function<double(const std::string& formula, double value)> perturb;
+  /// Loads a scene file or mesh (the analysis layer cannot: load/ sits above it). Set by the
+  /// CLI and the tests; empty: experiments that need files report them as not measured.
+  std::function<LoadedScene(const std::string& path)> load;
 };
+
+/// The prediction `value` of formula `name` as the experiment uses it: value itself, or
+/// config.perturb(name, value) when the hook is set.
+double predict(const Config& config, const std::string& name, double value);
 
 /// The nine experiment names in report order.
 const std::vector<std::string>& names();
@@ -93,15 +148,22 @@ ExperimentResult worst_traditional(const Config& c);
 ExperimentResult worst_stochastic(const Config& c);
 ExperimentResult worst_deterministic(const Config& c);
 ExperimentResult expected(const Config& c);
+ExperimentResult traversed(const Config& c);
 ExperimentResult failed_tests(const Config& c);
 ExperimentResult lights(const Config& c);
 ExperimentResult noise(const Config& c);
+ExperimentResult noise_baked(const Config& c);
 ExperimentResult more_levels(const Config& c);
 ExperimentResult linear_cost(const Config& c);
+ExperimentResult p_vs_primitives(const Config& c);
+ExperimentResult premise(const Config& c);
+ExperimentResult sorting(const Config& c);
 
-/// Least-squares fit y = a + b x; returns {a, b, r^2}.
+/// Least-squares fit y = a + b x; returns {a, b, r^2} and the slope's standard error and
+/// 95% confidence half-width (Student t with n - 2 degrees of freedom; 0 for n < 3).
 struct LinearFit {
   double a = 0, b = 0, r2 = 0;
+  double se_b = 0, ci95_b = 0;
 };
 LinearFit fit_line(const std::vector<double>& x, const std::vector<double>& y);
 

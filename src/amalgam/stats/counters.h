@@ -21,12 +21,25 @@ struct Counters {
   std::array<std::array<std::uint64_t, 3>, 2> tests{};
   std::array<std::uint64_t, kCountedLevels> by_level{};
   std::array<std::uint64_t, 2> rays{};
+  /// Nodes (bounding volumes and amalgams) a traversal reached -- took from its sorted list
+  /// (or, in stored order, entered) and then entered or rendered -- per ray kind. With the
+  /// primitive tests this is the paper's count of "objects traversed" (Eq. 4, Figure 4): a
+  /// sorted traversal tests all children of a node it enters, but the paper counts only those
+  /// reached in sorted order until the first hit, as if a space-partitioning modeller delivered
+  /// them in order. `tests` is unchanged by it.
+  std::array<std::uint64_t, 2> reached{};
 
   void count_test(RayKind r, ObjectKind o, int level) {
     ++tests[static_cast<int>(r)][static_cast<int>(o)];
     ++by_level[static_cast<unsigned>(level) < kCountedLevels ? level : kCountedLevels - 1];
   }
   void count_ray(RayKind r) { ++rays[static_cast<int>(r)]; }
+  void count_reached(RayKind r) { ++reached[static_cast<int>(r)]; }
+
+  /// The paper's "objects traversed" for ray kind r: nodes reached plus primitives tested.
+  std::uint64_t traversed_of(RayKind r) const {
+    return reached[static_cast<int>(r)] + tests[static_cast<int>(r)][0];
+  }
 
   std::uint64_t tests_of(RayKind r) const {
     const auto& t = tests[static_cast<int>(r)];
@@ -41,7 +54,7 @@ struct Counters {
     for (int r = 0; r < 2; ++r)
       for (int k = 0; k < 3; ++k) tests[r][k] += o.tests[r][k];
     for (int l = 0; l < kCountedLevels; ++l) by_level[l] += o.by_level[l];
-    for (int r = 0; r < 2; ++r) rays[r] += o.rays[r];
+    for (int r = 0; r < 2; ++r) rays[r] += o.rays[r], reached[r] += o.reached[r];
   }
 };
 
@@ -49,6 +62,7 @@ struct Counters {
 struct NullCounters {
   void count_test(RayKind, ObjectKind, int) {}
   void count_ray(RayKind) {}
+  void count_reached(RayKind) {}
   std::uint64_t total() const { return 0; }
 };
 

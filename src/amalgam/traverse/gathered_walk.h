@@ -37,6 +37,7 @@ class GatheredWalk {
       const Item it = stack_.back();
       stack_.pop_back();
       if (it.t > s.ray.tmax) continue;
+      s.counters.count_reached(s.kind);
       if constexpr (State::kMayRender) {
         if (it.render) {
           s.render_amalgam(it.node, it.level, s.h.bounds(it.node), it.t);

@@ -14,6 +14,7 @@ struct GenericWalk {
   /// read when the LOD policy may render).
   static void enter(State& s, NodeId id, int level, const Bbox& b, float t_entry) {
     if (t_entry > s.ray.tmax) return;  // a closer hit was found since this node was tested
+    s.counters.count_reached(s.kind);
     if constexpr (State::kMayRender) {
       if (s.renders(b, level, t_entry)) {
         s.render_amalgam(id, level, b, t_entry);

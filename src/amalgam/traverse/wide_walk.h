@@ -74,6 +74,7 @@ class WideWalk {
     while (sp > 0 && !s.done) {
       const StackItem it = st[--sp];
       if (it.t > s.ray.tmax) continue;
+      s.counters.count_reached(s.kind);
       if constexpr (State::kMayRender) {
         if (s.lod.may_render(it.level)) {
           const Bbox b = s.h.bounds(it.node);

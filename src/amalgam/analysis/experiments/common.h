@@ -44,6 +44,12 @@ inline double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+/// Gives every check added since the last call (those with no statement yet) statement `id`.
+inline void tag(ExperimentResult& r, const std::string& id) {
+  for (Check& c : r.checks)
+    if (c.statement.empty()) c.statement = id;
+}
+
 inline double u(std::uint64_t v) {
   return static_cast<double>(v);
 }

@@ -79,7 +79,8 @@ ExperimentResult expected(const Config& c) {
   auto add_row = [&](int sweep, int l1, int lm, double p, const Mean& mi, const Mean& mt,
                      double tests_exact) {
     const double b = std::pow(n, l1);
-    const double e = formulas::expected_visits_exact(p, b);
+    const double e = predict(c, "expected_visits_exact", formulas::expected_visits_exact(p, b));
+    const double printed = safe([&] { return formulas::expected_visits_eq9_as_printed(p, b); });
     const double eq1013 = sweep == 0 ? safe([&] { return formulas::eq10_traditional(n, p); })
                                      : safe([&] { return formulas::eq13_scale_sensitive(p, b); });
     r.table.add({double(sweep),
@@ -92,10 +93,10 @@ ExperimentResult expected(const Config& c) {
                  mi.mean(),
                  mi.se(),
                  e,
-                 safe([&] { return formulas::expected_visits_eq9_as_printed(p, b); }),
+                 printed,
                  eq1013,
-                 formulas::eq12_limit(n),
-                 formulas::eq12_correct_limit(n),
+                 predict(c, "eq12_limit", formulas::eq12_limit(n)),
+                 predict(c, "eq12_correct_limit", formulas::eq12_correct_limit(n)),
                  mt.mean(),
                  mt.se(),
                  tests_exact,
@@ -106,18 +107,30 @@ ExperimentResult expected(const Config& c) {
     // Tolerance: 4 standard errors, plus 5/rays of the prediction for outcomes too rare to
     // be seen at all in `rays` draws (then the sample variance is 0).
     const double rare = 5.0 / mi.count;
+    // Sweep 0 is Eq. 10 (p/b = n), sweep 1 Eq. 13 (b fixed), sweep 2 Eq. 9 in general.
+    const std::string eq = sweep == 0 ? "Eq. 10" : sweep == 1 ? "Eq. 13" : "Eq. 9";
     r.checks.push_back({where + ": mean visits on level l1 = E[i] (4 s.e.)", mi.mean(), e,
-                        4 * mi.se() + rare * e});
+                        4 * mi.se() + rare * e, Role::kSupports, eq});
+    // The printed closed form (Eq. 9, or its substitution Eq. 10 / 13) where it can be
+    // evaluated in floating point: it must be the same number.
+    const double closed = sweep == 0 ? eq1013 : sweep == 1 ? eq1013 : printed;
+    if (!std::isnan(closed))
+      r.checks.push_back({where + ": " + eq + " as printed = E[i] (1e-6 relative)", closed, e,
+                          1e-6 * e, Role::kSupports, eq});
     r.checks.push_back({where + ": mean primary tests = exact expectation (4 s.e.)", mt.mean(),
-                        tests_exact, 4 * mt.se() + rare * tests_exact});
+                        tests_exact, 4 * mt.se() + rare * tests_exact, Role::kSupports,
+                        "O(log p) / O(log b)"});
   };
 
+  LinearFit shadow_trad, shadow_ss;
+  std::string shadow_outliers;
+  std::vector<double> shadow;  // mean shadow-ray tests per primary ray, one per row
   // Sweep 0: traditional renderer, l1 = l_max - 1, p = n^l_max (p/b = n).
   const int max_lmax = c.quick ? 10 : 20;
   for (int lm = 2; lm <= max_lmax; ++lm) {
     const double p = std::pow(n, lm);
     const int l1 = lm - 1;
-    Mean mi, mt;
+    Mean mi, mt, ms;
     for (int k = 0; k < rays; ++k) {
       const LoadedScene s =
           scene("poisson", {{"n", str(n)}, {"depth", str(lm)}, {"p", str(p)}, {"seed", str(k)}});
@@ -125,15 +138,17 @@ ExperimentResult expected(const Config& c) {
       const double b = std::pow(n, l1);
       mi.add(t.hit.kind == TraceHit::Kind::kPrimitive ? double(t.hit.id / n + 1) : b);
       mt.add(u(t.counters.tests_of(RayKind::kPrimary)));
+      ms.add(u(t.counters.tests_of(RayKind::kShadow)));
     }
     add_row(0, l1, lm, p, mi, mt, formulas::expected_tests_traditional(n, lm, p));
+    shadow.push_back(ms.mean());
   }
   // Sweep 1: scale-sensitive, b = n^4 fixed, p swept.
   const int l1f = 4, depth1 = c.quick ? 16 : 30;
   for (int k2 = -2; k2 <= (c.quick ? 12 : 24); k2 += c.quick ? 2 : 1) {
     const double p = std::ldexp(1.0, k2);
     const LoadedScene s = scene("poisson", {{"n", str(n)}, {"depth", str(depth1)}, {"p", str(p)}});
-    Mean mi, mt;
+    Mean mi, mt, ms;
     for (int k = 0; k < rays; ++k) {
       RenderOptions o = at_level(l1f);
       o.seed = static_cast<std::uint64_t>(k);
@@ -142,15 +157,17 @@ ExperimentResult expected(const Config& c) {
       mi.add(t.hit.kind == TraceHit::Kind::kAmalgam ? double(TubeHierarchy::index_of(t.hit.id) + 1)
                                                     : b);
       mt.add(u(t.counters.tests_of(RayKind::kPrimary)));
+      ms.add(u(t.counters.tests_of(RayKind::kShadow)));
     }
     add_row(1, l1f, depth1, p, mi, mt, formulas::expected_tests_sorted(n, l1f, p));
+    shadow.push_back(ms.mean());
   }
   // Sweep 2: scale-sensitive, p fixed, l1 (so b = n^l1) swept.
   const int depth2 = c.quick ? 12 : 18;
   const double p2 = std::pow(n, depth2);
   for (int l1 = 1; l1 < depth2 - 1; l1 += c.quick ? 2 : 1) {
     const LoadedScene s = scene("poisson", {{"n", str(n)}, {"depth", str(depth2)}, {"p", str(p2)}});
-    Mean mi, mt;
+    Mean mi, mt, ms;
     for (int k = 0; k < rays; ++k) {
       RenderOptions o = at_level(l1);
       o.seed = static_cast<std::uint64_t>(k);
@@ -158,10 +175,35 @@ ExperimentResult expected(const Config& c) {
       mi.add(t.hit.kind == TraceHit::Kind::kAmalgam ? double(TubeHierarchy::index_of(t.hit.id) + 1)
                                                     : std::pow(n, l1));
       mt.add(u(t.counters.tests_of(RayKind::kPrimary)));
+      ms.add(u(t.counters.tests_of(RayKind::kShadow)));
     }
     add_row(2, l1, depth2, p2, mi, mt, formulas::expected_tests_sorted(n, l1, p2));
+    shadow.push_back(ms.mean());
   }
 
+  // Secondary rays: the one shadow ray (the light is at the camera) crosses, back towards the
+  // light, what the primary ray passed. The paper: "the expected times for secondary rays
+  // should have the same asymptotic behavior".
+  r.table.columns.push_back("mean_shadow");
+  for (std::size_t i = 0; i < r.table.rows.size(); ++i) r.table.rows[i].push_back(shadow[i]);
+  {
+    std::vector<double> x0, y0, x1, y1;
+    for (const auto& row : r.table.rows) {
+      // l_max = 20 is left out: there the hit lies about 2^20 from the origin and the shadow
+      // ray, started a single-precision offset off the hit point, often tests only the root box
+      // (1 test on the ray of seed 3) -- a limit of this scene in float, reported below.
+      if (row[0] == 0 && row[3] <= 19) x0.push_back(row[18]), y0.push_back(row.back());
+      if (row[0] == 0 && row[3] > 19)
+        shadow_outliers += "l_max = " + fmt(row[3]) + ": " + fmt(row.back()) + " tests; ";
+      if (row[0] == 1 && row[4] >= 64) x1.push_back(row[18]), y1.push_back(row.back());
+    }
+    shadow_trad = fit_line(x0, y0);
+    shadow_ss = fit_line(x1, y1);
+    r.checks.push_back({"traditional shadow tests linear in log p (r^2)", shadow_trad.r2, 1.0, 0.01,
+                        Role::kSupports, "Secondary rays (expected)"});
+    r.checks.push_back({"scale-sensitive shadow tests flat in p for p >> b (slope per doubling)",
+                        shadow_ss.b, 0.0, 0.25, Role::kSupports, "Secondary rays (expected)"});
+  }
   // Fits: traditional tests against log2 p; scale-sensitive against log2 b and against p.
   auto fit_of = [&](int sweep, const std::string& xcol, bool log_y = false) {
     std::vector<double> x, y;
@@ -179,6 +221,7 @@ ExperimentResult expected(const Config& c) {
   r.checks.push_back({"scale-sensitive tests linear in log b (r^2)", ss_b.r2, 1.0, 0.01});
   r.checks.push_back(
       {"scale-sensitive tests flat in p for p >> b (slope per doubling of p)", ss_p.b, 0.0, 0.25});
+  tag(r, "O(log p) / O(log b)");
   // Eq. 12: at the largest p, the measured mean vs the printed and the corrected limit.
   std::size_t last_trad = 0;
   for (std::size_t i = 0; i < r.table.rows.size(); ++i)
@@ -187,9 +230,9 @@ ExperimentResult expected(const Config& c) {
   const double z_printed = (lt[7] - lt[12]) / lt[8];
   const double z_correct = (lt[7] - lt[13]) / lt[8];
   r.checks.push_back({"traditional E[i] at largest p = corrected Eq. 12 limit 1/(1-e^-n)", lt[7],
-                      lt[13], 4 * lt[8]});
+                      lt[13], 4 * lt[8], Role::kSupports, "Eq. 12"});
   r.checks.push_back({"printed Eq. 12 (1-e^-n) is below the measurement by > 10 s.e.",
-                      std::min(z_printed, 10.0), 10.0, 0.0});
+                      std::min(z_printed, 10.0), 10.0, 0.0, Role::kRefutesPrinted, "Eq. 12"});
 
   r.summary_columns = {
       "sweep",        "l1",           "p",          "b",           "mean_i",      "eq9_exact",
@@ -231,16 +274,32 @@ ExperimentResult expected(const Config& c) {
                       {{"log2_b", "mean_tests", "measured", false, "sweep", 2},
                        {"log2_b", "tests_exact", "exact expectation", true, "sweep", 2},
                        {"log2_b", "eq8_expected", "Eq. 8 model", true, "sweep", 2}}});
-  r.verdict = Verdict::kHoldsWithCorrection;
+  // The bullets below follow the checks (a wrong formula injected through Config::perturb
+  // must change them as it changes the verdict).
+  const auto held = [&](const char* id) { return verdict_of(r.checks, id) == Verdict::kHolds; };
+  const bool eq9_holds = held("Eq. 9") && held("Eq. 10") && held("Eq. 13");
+  const auto v12 = verdict_of(r.checks, "Eq. 12");
+  const std::string eq12_head =
+      v12 == Verdict::kHoldsWithCorrection ? "* **Eq. 12 is wrong as printed**: "
+      : v12 == Verdict::kHolds ? "* **Eq. 12 as printed was not refuted** (see the checks): "
+                               : "* **Eq. 12: the measurement matches neither the printed nor "
+                                 "the corrected limit** (see the checks): ";
   r.findings =
       "Measured over " + str(rays) +
       " rays per point (traditional: a new Poisson realisation per ray; scale-sensitive: a new "
-      "stochastic-opacity seed per ray).\n\n"
-      "* **Eq. 9, 10, 13 hold** (they are algebraically the truncated-geometric mean "
+      "stochastic-opacity seed per ray). The Poisson model makes each amalgam pass the ray "
+      "with probability e^{-p/b} independently of all others: uncorrelated, exponential "
+      "transmittance along the ray, as in a homogeneous medium. builtin:poisson is built to "
+      "follow it; real scenes are correlated (a wall stops every ray that reaches it, an empty "
+      "region passes them all), so there Eq. 9 is a model, not a prediction.\n\n" +
+      std::string(eq9_holds ? "* **Eq. 9, 10, 13 hold** "
+                            : "* **Eq. 9, 10, 13 do not all hold (see the failed checks)** ") +
+      "(they are algebraically the truncated-geometric mean "
       "(1 - e^{-p})/(1 - e^{-p/b})); every measured mean of visits on level l1 is within 4 "
       "standard errors of it. The printed closed forms overflow/cancel numerically for large "
-      "p/b (nan in the CSV) but are exact where they can be evaluated.\n"
-      "* **Eq. 12 is wrong**: its left-hand side e^{-n}(e^n - 1)(e^{-n} - 1)^{-2} equals "
+      "p/b (nan in the CSV) but are exact where they can be evaluated.\n" +
+      eq12_head +
+      "its left-hand side e^{-n}(e^n - 1)(e^{-n} - 1)^{-2} equals "
       "1/(1 - e^{-n}), but the paper prints (1 - e^{-n}), the reciprocal. At the largest p "
       "(p = " +
       fmt(lt[4]) + ") the measured mean is " + fmt(lt[7]) + " +- " + fmt(lt[8]) +
@@ -256,8 +315,24 @@ ExperimentResult expected(const Config& c) {
       fmt(ss_b.b) + ", r^2 = " + fmt(ss_b.r2) +
       "). Measured tests match the exact expectation of this sorted traversal "
       "(`expected_tests_sorted`) within statistical error. Eq. 8's max(log_n b + i, i C_b) "
-      "model undercounts by about a factor n because a sorted traversal tests all n children "
-      "of each entered node, a constant factor that leaves the asymptotics unchanged.";
+      "model is below these intersection tests by about a factor n because this traversal "
+      "tests all n children of each entered node while the paper counts objects traversed "
+      "(children reached in sorted order until the first hit): a counting convention, a "
+      "constant factor that leaves the asymptotics unchanged. Counted the paper's way, Eq. 8 "
+      "is checked in [traversed](#traversed).\n"
+      "* **Secondary rays**: the shadow ray (light at the camera, so it crosses back over what "
+      "the primary ray passed) costs on average a + c log2 p with c = " +
+      fmt(shadow_trad.b) + " (r^2 = " + fmt(shadow_trad.r2) +
+      ") for the traditional renderer and is flat in p for the scale-sensitive one (slope " +
+      fmt(shadow_ss.b) +
+      " tests per doubling of p): the same asymptotics as the primary ray, as the paper says." +
+      (shadow_outliers.empty()
+           ? std::string()
+           : " Left out of the fit: " + shadow_outliers +
+                 "at l_max = 20 the hit lies about 2^20 from the origin and the shadow ray, "
+                 "started a single-precision offset off the hit point, often tests only the root "
+                 "box: "
+                 "a limit of builtin:poisson in float at that depth, not of the model.");
   return r;
 }
 

@@ -55,7 +55,7 @@ ExperimentResult lights(const Config& c) {
         {"lights", "stoch_pred", "(1+L) C_s0", true},
         {"lights", "det_total", "deterministic", false},
         {"lights", "det_bound", "C_s0 + L C_sd1", true}}});
-  r.verdict = Verdict::kHolds;
+  tag(r, "Lights");
   r.findings =
       "All three renderers scale exactly linearly in the number of lights L: "
       "traditional (1+L) C_t0 = " +

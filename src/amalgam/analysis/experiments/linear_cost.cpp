@@ -188,7 +188,7 @@ ExperimentResult linear_cost(const Config& c) {
                        {"P", "ray2d_overlap", "RAY2D, overlapping", false},
                        {"P", "find_pred", "log2 P + 1", true},
                        {"P", "pt2d_overlap_pred", "1 + 4(sqrt P - 1)", true}}});
-  r.verdict = Verdict::kHolds;
+  tag(r, "FIND / PT2D / RAY2D");
   r.findings =
       "Counts are exact node tests averaged over " + str(queries) +
       " random queries per size. FIND and PT2D on the tiling hierarchy cost exactly "

@@ -120,8 +120,10 @@ ExperimentResult noise(const Config& c) {
     if (vr < 1) ++better;
     if (cr < 1) ++cheaper;
     const double cell = 2.0 / std::pow(2.0, configs[ci]);
+    // Pixel size on the front face: the camera is at z = 4, the cube's front face at z = 1
+    // (distance 3), vertical field of view 40 degrees over `size` pixels.
     lines += "| " + str(configs[ci]) + " | " +
-             fmt(cell / (2.0 * 4.0 * std::tan(20.0 * M_PI / 180.0) / size)) + " | " +
+             fmt(cell / (2.0 * 3.0 * std::tan(20.0 * M_PI / 180.0) / size)) + " | " +
              fmt(sigma2[ci]) + " | " + fmt(vr) + " | " + fmt(tps[ci]) + " | " +
              fmt(sigma2[ci] / target) + " | " + fmt(sigma2[ci] / target * tps[ci]) + " | " +
              fmt(cr) + " |\n";
@@ -153,13 +155,19 @@ ExperimentResult noise(const Config& c) {
   r.table.columns.push_back("tests_per_pixel");
   for (auto& row : r.table.rows) row.push_back(row[5] * row[2]);
   r.panels = {pv, pc};
-  r.checks.push_back({"stochastic amalgams at some level have lower per-sample variance",
-                      better > 0 ? 1.0 : 0.0, 1.0, 0});
   const int nl = int(levels.size());
-  // The claim has two parts, lower variance and lower cost at equal noise.
-  r.verdict = better == nl && cheaper == nl ? Verdict::kHolds
-              : cheaper > 0                 ? Verdict::kHoldsWithCorrection
-                                            : Verdict::kDoesNotHold;
+  // The claim has two parts. Its conclusion (cheaper at equal noise) must hold at every level;
+  // its mechanism (lower per-sample variance than the traditional renderer) is checked as a
+  // printed claim that the measurement may refute.
+  for (std::size_t ci = 1; ci < configs.size(); ++ci) {
+    const double cr = (sigma2[ci] * tps[ci]) / (sigma2[0] * tps[0]);
+    r.checks.push_back({"level " + str(configs[ci]) +
+                            ": tests to reach the target noise below the traditional renderer's",
+                        cr < 1 ? 1.0 : 0.0, 1.0, 0});
+  }
+  r.checks.push_back({"mechanism: per-sample variance not lower than traditional at some level",
+                      better < nl ? 1.0 : 0.0, 1.0, 0, Role::kRefutesPrinted});
+  tag(r, "Noise");
   r.findings =
       "Per-sample variance sigma^2 (mean over pixels of the variance across " + str(seeds) +
       " seeds, times spp) of the traditional renderer: " + fmt(sigma2[0]) + " at " + fmt(tps[0]) +
@@ -175,15 +183,27 @@ ExperimentResult noise(const Config& c) {
       fmt(vmin) + " to " + fmt(vmax) + " (lower at " + str(better) + " of " + str(nl) +
       " levels); the total tests needed to reach the target noise range from " + fmt(cmin) +
       " to " + fmt(cmax) + " of the traditional renderer's (cheaper at " + str(cheaper) + " of " +
-      str(nl) +
-      " levels). So the paper's *conclusion* (stochastic amalgams remain cheaper after the "
-      "extra sampling) holds here, but its *mechanism* (an amalgam has lower image variance "
-      "than the bounding volume it replaces) is not what carries it: where an amalgam covers "
-      "several pixels its colour is constant across the pixel, but the binary opacity "
-      "decision (a ray sees through an amalgam with probability 1 - fill^2 = 0.36) brings "
-      "back about as much variance as the sub-pixel detail it removes. The saving comes from "
-      "the cheaper samples. Note that the two renderers converge to different images (the "
-      "amalgams' appearance is an average), so this compares noise, not error.";
+      str(nl) + " levels). " +
+      std::string(cheaper == nl ? "So the paper's *conclusion* (stochastic amalgams remain "
+                                  "cheaper after the extra sampling) holds at every level here"
+                                : "So the paper's *conclusion* (stochastic amalgams remain "
+                                  "cheaper after the extra sampling) fails at " +
+                                      str(nl - cheaper) + " of " + str(nl) + " levels") +
+      (better == nl
+           ? "; its *mechanism* (lower image variance than the bounding volume) holds at every "
+             "level too. "
+           : ", but its *mechanism* (an amalgam has lower image variance than the bounding "
+             "volume it replaces) is not what carries it: where an amalgam covers several pixels "
+             "its colour is constant across the pixel, but the binary opacity decision (a ray "
+             "sees through an amalgam with probability 1 - fill^2 = 0.36) brings back about as "
+             "much variance as the sub-pixel detail it removes. The saving comes from the "
+             "cheaper samples. ") +
+      "This scene sets every amalgam's opacity to exactly its geometric coverage (fill^2), so "
+      "it cannot show the mechanism at its best; scenes whose amalgams are baked from their "
+      "contents (a mesh, the field) are measured in [noise-baked](#noise-baked). Note that the two "
+      "renderers "
+      "converge to different images (the amalgams' appearance is an average), so this compares "
+      "noise, not error.";
   return r;
 }
 

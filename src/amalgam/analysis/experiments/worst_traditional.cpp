@@ -29,7 +29,7 @@ ExperimentResult worst_traditional(const Config& c) {
       const TraceOutput t = trace_centre(sc, traditional());
       const double p = std::pow(s.n, d);
       const double prim = u(t.counters.tests_of(RayKind::kPrimary));
-      const double pred = formulas::c_t0(s.n, d);
+      const double pred = predict(c, "c_t0", formulas::c_t0(s.n, d));
       r.table.add({double(s.n), double(d), p, prim, u(t.counters.tests_of(RayKind::kShadow)), pred,
                    prim / p});
       r.checks.push_back({"n=" + str(s.n) + " l_max=" + str(d) + " primary = C_t0", prim, pred, 0});
@@ -73,7 +73,7 @@ ExperimentResult worst_traditional(const Config& c) {
                        {"p", "c_t0", "C_t0, n=2", true, "n", 2},
                        {"p", "c_t0", "C_t0, n=3", true, "n", 3},
                        {"p", "c_t0", "C_t0, n=8", true, "n", 8}}});
-  r.verdict = Verdict::kHolds;
+  tag(r, "C_t0");
   r.findings =
       "Primary and shadow ray each cost exactly C_t0 for every (n, l_max) measured "
       "(largest: p = " +

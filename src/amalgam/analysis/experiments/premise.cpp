@@ -1,0 +1,262 @@
+/// \file Experiment premise: the paper measures cost in intersection tests ("the costs of
+/// performing ray/object intersection tests overwhelms the costs of other operations"). How far
+/// does wall time follow the test counts of this renderer? Renders of the builtin scenes and of
+/// two baked scenes (Wuson mesh, the field; loaded through Config::load), traditional and
+/// scale-sensitive; time fitted against the total tests alone and against the tests by kind.
+/// Also the conclusions' "in any case, the scale-sensitive technique is no slower".
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "amalgam/analysis/experiments/common.h"
+
+namespace amalgam::experiments {
+using namespace detail;
+
+namespace {
+
+/// Least squares through the origin, y ~ X c, by the normal equations (Gaussian elimination
+/// with partial pivoting on columns scaled to a maximum of 1). A column that is all zero
+/// gets coefficient 0.
+std::vector<double> least_squares(const std::vector<std::vector<double>>& X,
+                                  const std::vector<double>& y) {
+  const std::size_t k = X.empty() ? 0 : X[0].size();
+  std::vector<double> scale(k, 0);
+  for (const auto& row : X)
+    for (std::size_t j = 0; j < k; ++j) scale[j] = std::max(scale[j], std::fabs(row[j]));
+  std::vector<std::vector<double>> A(k, std::vector<double>(k + 1, 0));
+  for (std::size_t i = 0; i < X.size(); ++i)
+    for (std::size_t a = 0; a < k; ++a) {
+      if (scale[a] == 0) continue;
+      for (std::size_t b = 0; b < k; ++b)
+        if (scale[b] > 0) A[a][b] += X[i][a] / scale[a] * X[i][b] / scale[b];
+      A[a][k] += X[i][a] / scale[a] * y[i];
+    }
+  for (std::size_t a = 0; a < k; ++a)
+    if (scale[a] == 0) A[a][a] = 1;  // coefficient 0
+  for (std::size_t col = 0; col < k; ++col) {
+    std::size_t piv = col;
+    for (std::size_t rr = col + 1; rr < k; ++rr)
+      if (std::fabs(A[rr][col]) > std::fabs(A[piv][col])) piv = rr;
+    std::swap(A[col], A[piv]);
+    if (std::fabs(A[col][col]) < 1e-300) continue;
+    for (std::size_t rr = 0; rr < k; ++rr) {
+      if (rr == col) continue;
+      const double f = A[rr][col] / A[col][col];
+      for (std::size_t cc = col; cc <= k; ++cc) A[rr][cc] -= f * A[col][cc];
+    }
+  }
+  std::vector<double> c(k, 0);
+  for (std::size_t a = 0; a < k; ++a)
+    if (scale[a] > 0 && std::fabs(A[a][a]) > 1e-300) c[a] = A[a][k] / A[a][a] / scale[a];
+  return c;
+}
+
+}  // namespace
+
+ExperimentResult premise(const Config& c) {
+  ExperimentResult r;
+  r.title =
+      "The premise: cost = intersection tests; \"the scale-sensitive technique is no slower\"";
+  r.claim =
+      "\"The costs of performing ray/object intersection tests overwhelms the costs of other "
+      "operations ... the analysis below will measure time costs in the number of "
+      "intersection tests.\" Conclusions: \"In any case, the scale-sensitive technique is no "
+      "slower.\"";
+  r.prediction =
+      "Wall time of whole renders fitted (least squares through 0) against the total tests "
+      "alone, and against the tests by kind: node tests of the explicit (baked, SIMD-tested) "
+      "hierarchies, node tests of the implicit builtin scenes (one at a time), primitive "
+      "tests, primary rays (shading) and shadow rays. The scale-sensitive renderer makes no "
+      "more tests than the traditional one on the same scene.";
+  r.table.columns = {"scene",         "config",        "level",        "seconds",
+                     "node_simd",     "node_scalar",   "prim_tests",   "primary_rays",
+                     "shadow_rays",   "tests",         "fit_tests",    "fit_kinds",
+                     "err_tests_pct", "err_kinds_pct", "time_vs_trad", "tests_vs_trad"};
+  struct Spec {
+    std::string label, spec;
+    bool file;
+    std::vector<int> levels;  ///< scale-sensitive levels (-1: footprint 1 pixel)
+  };
+  const std::vector<Spec> specs = {
+      {"builtin:prisms corner", "corner", false, {3, 5, -1}},
+      {"builtin:prisms front", "front", false, {2, 4, -1}},
+      {"Wuson mesh", "/usr/share/assimp/models/PLY/Wuson.ply", true, {3, 6, -1}},
+      {"the field", "scenes/field.json", true, {4, 8, -1}}};
+  const int size = c.quick ? 24 : 256;
+  const int reps = c.quick ? 1 : 3;
+  std::string unavailable;
+  for (std::size_t si = 0; si < specs.size(); ++si) {
+    const Spec& sp = specs[si];
+    std::optional<LoadedScene> s;
+    try {
+      if (!sp.file)
+        s.emplace(scene("prisms", {{"depth", "8"}, {"view", sp.spec}}));
+      else if (c.load)
+        s.emplace(c.load(sp.spec));
+      else
+        throw std::runtime_error("no scene loader given (Config::load)");
+    } catch (const std::exception& e) {
+      unavailable += "* " + sp.label + ": not measured: " + e.what() + "\n";
+      continue;
+    }
+    double trad_seconds = 0, trad_tests = 0;
+    std::vector<int> configs = {-2};  // -2: traditional
+    for (int l : sp.levels) configs.push_back(l);
+    for (int cfg : configs) {
+      RenderOptions o = cfg == -2 ? traditional() : cfg == -1 ? RenderOptions{} : at_level(cfg);
+      if (cfg == -1) o.footprint = 1.0f;
+      o.width = o.height = size;
+      o.spp = 1;
+      o.threads = c.threads;
+      double best = 1e300;
+      RenderOutput out;
+      for (int k = 0; k < reps; ++k) {
+        out = render(*s, o);
+        best = std::min(best, out.seconds);
+      }
+      const Counters& k = out.counters;
+      const double nodes =
+          u(k.tests_of(ObjectKind::kBoundingVolume) + k.tests_of(ObjectKind::kAmalgam));
+      const double tests = u(k.total());
+      if (cfg == -2) trad_seconds = best, trad_tests = tests;
+      r.table.add({double(si),
+                   double(cfg == -2   ? 0
+                          : cfg == -1 ? 2
+                                      : 1),
+                   double(cfg), best, sp.file ? nodes : 0, sp.file ? 0 : nodes,
+                   u(k.tests_of(ObjectKind::kPrimitive)), u(k.rays[0]), u(k.rays[1]), tests, 0, 0,
+                   0, 0, best / trad_seconds, tests / trad_tests});
+      if (cfg != -2)
+        r.checks.push_back({sp.label + (cfg == -1 ? ", footprint 1" : ", level " + str(cfg)) +
+                                ": scale-sensitive makes no more tests than traditional",
+                            std::max(tests / trad_tests, 1.0), 1.0, 0, Role::kSupports,
+                            "No slower"});
+    }
+  }
+  // Fits over all renders.
+  std::vector<std::vector<double>> X1, X5;
+  std::vector<double> y;
+  for (const auto& row : r.table.rows) {
+    X1.push_back({row[9]});
+    X5.push_back({row[4], row[5], row[6], row[7], row[8]});
+    y.push_back(row[3]);
+  }
+  const std::vector<double> c1 = least_squares(X1, y);
+  // By kind: a cost per kind cannot be negative; a kind whose fitted coefficient comes out
+  // negative (not separable from the others on these renders) is dropped and the fit redone.
+  std::vector<double> c5;
+  std::vector<bool> dropped(5, false);
+  for (int round = 0; round < 5; ++round) {
+    std::vector<std::vector<double>> Xk = X5;
+    for (auto& row : Xk)
+      for (std::size_t j = 0; j < 5; ++j)
+        if (dropped[j]) row[j] = 0;
+    c5 = least_squares(Xk, y);
+    std::size_t worst = 5;
+    for (std::size_t j = 0; j < 5; ++j)
+      if (c5[j] < 0 && (worst == 5 || c5[j] < c5[worst])) worst = j;
+    if (worst == 5) break;
+    dropped[worst] = true;
+  }
+  const char* kind_names[5] = {"explicit node test", "builtin node test", "primitive test",
+                               "primary ray", "shadow ray"};
+  std::string kinds_text, dropped_text;
+  for (std::size_t j = 0; j < 5; ++j) {
+    if (dropped[j]) {
+      dropped_text += std::string(dropped_text.empty() ? "" : ", ") + kind_names[j];
+      continue;
+    }
+    kinds_text +=
+        std::string(kinds_text.empty() ? "" : ", ") + kind_names[j] + " " + fmt(c5[j] * 1e9);
+  }
+  double ss_tot = 0, ss1 = 0, ss5 = 0, ymean = 0, worst1 = 0, worst5 = 0;
+  for (double v : y) ymean += v / double(y.size());
+  std::string worst_label;
+  for (std::size_t i = 0; i < r.table.rows.size(); ++i) {
+    auto& row = r.table.rows[i];
+    row[10] = c1[0] * row[9];
+    row[11] = c5[0] * row[4] + c5[1] * row[5] + c5[2] * row[6] + c5[3] * row[7] + c5[4] * row[8];
+    row[12] = 100 * (row[10] / row[3] - 1);
+    row[13] = 100 * (row[11] / row[3] - 1);
+    ss_tot += (row[3] - ymean) * (row[3] - ymean);
+    ss1 += (row[3] - row[10]) * (row[3] - row[10]);
+    ss5 += (row[3] - row[11]) * (row[3] - row[11]);
+    if (std::fabs(row[12]) > worst1) {
+      worst1 = std::fabs(row[12]);
+      worst_label = specs[std::size_t(row[0])].label + " " +
+                    (row[1] == 0   ? std::string("traditional")
+                     : row[1] == 2 ? std::string("footprint 1")
+                                   : "level " + fmt(row[2]));
+    }
+    worst5 = std::max(worst5, std::fabs(row[13]));
+  }
+  const double r2_1 = ss_tot > 0 ? 1 - ss1 / ss_tot : 1, r2_5 = ss_tot > 0 ? 1 - ss5 / ss_tot : 1;
+  // No pass/fail on timings: they depend on the machine and its load (the premise is
+  // measured and stated, not checked).
+  double slower = 0, slower_tests = 0;
+  std::string slower_label;
+  for (const auto& row : r.table.rows)
+    if (row[1] != 0 && row[14] > slower)
+      slower_label = specs[std::size_t(row[0])].label +
+                     (row[1] == 2 ? std::string(", footprint 1") : ", level " + fmt(row[2]));
+  for (const auto& row : r.table.rows)
+    if (row[1] != 0)
+      slower = std::max(slower, row[14]), slower_tests = std::max(slower_tests, row[15]);
+  r.summary_columns = {"scene",         "config",       "level",        "seconds",
+                       "tests",         "fit_tests",    "fit_kinds",    "err_tests_pct",
+                       "err_kinds_pct", "time_vs_trad", "tests_vs_trad"};
+  for (std::size_t i = 0; i < r.table.rows.size(); ++i) r.summary_rows.push_back(i);
+  r.panels.push_back({"Render time against intersection tests",
+                      "intersection tests (all rays)",
+                      "seconds (" + str(size) + "^2 px, 1 spp, best of " + str(reps) + ")",
+                      true,
+                      true,
+                      {{"tests", "seconds", "traditional", false, "config", 0},
+                       {"tests", "seconds", "scale-sensitive, fixed level", false, "config", 1},
+                       {"tests", "seconds", "scale-sensitive, footprint 1", false, "config", 2},
+                       {"tests", "fit_tests", "fit: c x tests", false, "config", 0}}});
+  r.panels.push_back({"Scale-sensitive against traditional, same scene",
+                      "tests relative to traditional",
+                      "time relative to traditional",
+                      true,
+                      true,
+                      {{"tests_vs_trad", "time_vs_trad", "fixed level", false, "config", 1},
+                       {"tests_vs_trad", "time_vs_trad", "footprint 1", false, "config", 2}}});
+  tag(r, "Premise");
+  const auto v_no_slower = verdict_of(r.checks, "No slower");
+  r.findings =
+      "Renders of " + str(size) + "^2 pixels, 1 spp, " + str(c.threads) +
+      " threads (0: all cores), best of " + str(reps) +
+      " (config 0 traditional, 1 fixed level, "
+      "2 footprint 1 pixel).\n\n" +
+      unavailable + "* **Tests alone**: time = " + fmt(c1[0] * 1e9) +
+      " ns x tests, R^2 = " + fmt(r2_1) + "; worst render " + fmt(worst1) + "% off (" +
+      worst_label +
+      ").\n"
+      "* **Tests by kind** (ns each, non-negative least squares): " +
+      kinds_text +
+      (dropped_text.empty() ? std::string()
+                            : "; not separable from the others on these renders (fitted "
+                              "negative, dropped): " +
+                                  dropped_text) +
+      "; R^2 = " + fmt(r2_5) + ", worst render " + fmt(worst5) + "% off.\n" +
+      "* **No slower**: the scale-sensitive renderer made at most " + fmt(slower_tests) +
+      " times the traditional renderer's tests on the same scene (" +
+      (v_no_slower == Verdict::kHolds ? std::string("never more: holds in test counts")
+                                      : std::string("more somewhere: see the failed checks")) +
+      "); in wall time it took at most " + fmt(slower) + " times as long (" + slower_label + ")" +
+      (slower > 1 ? ": slower in time although it made fewer tests" : "") +
+      ". Wall time is measured on this machine (2 cores shared with other jobs) "
+      "and is not checked by the tests.\n\n"
+      "Counting tests predicts render time to the extent these R^2 say; one price per test "
+      "is off by up to " +
+      fmt(worst1) + "% for a single render (" + worst_label +
+      "): explicit node tests (SIMD, several boxes at once), builtin node tests (one box, "
+      "children computed on the fly), primitive tests and the per-ray work (camera ray, "
+      "shading, shadow-ray set-up) do not cost the same.";
+  return r;
+}
+
+}  // namespace amalgam::experiments

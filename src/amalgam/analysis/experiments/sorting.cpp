@@ -1,0 +1,99 @@
+/// \file Experiment sorting: the paper's remark that sorting a node's children costs little
+/// next to the intersection tests ("the renderer can use a linear-time bucket sort ... the
+/// sort has the same asymptotic cost as examining the objects"). On builtin:line, traditional
+/// renderer, worst case, a ray tests every object whatever the order, so sorted and stored
+/// order make exactly the same tests and the difference in wall time is the ordering work
+/// (this renderer: insertion sort of the hit children of each entered node). The primary ray
+/// meets the children in stored order (the sort's best case), its shadow ray in reverse order
+/// (the insertion sort's worst case, O(n^2) per node).
+
+#include <chrono>
+#include <cmath>
+
+#include "amalgam/analysis/experiments/common.h"
+
+namespace amalgam::experiments {
+using namespace detail;
+
+ExperimentResult sorting(const Config& c) {
+  ExperimentResult r;
+  r.title = "Sorting children: its cost next to the intersection tests";
+  r.claim =
+      "\"In practice, however, the cost of this sorting is insignificant compared to the cost "
+      "of performing intersection tests ... the renderer sorts exactly n objects at a time. "
+      "The renderer can use a linear-time bucket sort for this operation, which means the "
+      "sort has the same asymptotic cost as examining the objects in the first place.\"";
+  r.prediction =
+      "Same tests in sorted and stored order (worst case: everything is tested); wall time of "
+      "the sorted traversal at most a constant factor above the stored one, that factor not "
+      "growing with the depth (the sort is O(n) or O(n^2) per node for fixed n: a constant "
+      "per test).";
+  r.table.columns = {"n",
+                     "depth",
+                     "tests",
+                     "tests_stored",
+                     "us_sorted",
+                     "us_stored",
+                     "ns_per_test_sorted",
+                     "ns_per_test_stored",
+                     "overhead_pct"};
+  struct Case {
+    int n, depth;
+  };
+  // About 10^5 tests per ray pair at full size.
+  const std::vector<Case> cases =
+      c.quick ? std::vector<Case>{{2, 6}, {8, 3}, {64, 2}}
+              : std::vector<Case>{{2, 12}, {2, 15}, {3, 8},  {3, 10}, {8, 4},
+                                  {8, 5},  {16, 3}, {16, 4}, {64, 2}, {64, 3}};
+  bool same_tests = true;
+  const int min_tests = c.quick ? 1000 : 3000000;  // per timing, summed over repetitions
+  for (const Case& k : cases) {
+    const LoadedScene s = scene("line", {{"n", str(k.n)}, {"depth", str(k.depth)}});
+    RenderOptions sorted = traditional(), stored = traditional();
+    stored.sorted = false;
+    const Ray ray = s.env.camera.centre_ray(sorted.width, sorted.height);
+    const double tests = u(trace(s, sorted, ray).counters.total());
+    const double tests_stored = u(trace(s, stored, ray).counters.total());
+    const int reps = std::max(1, int(min_tests / std::max(1.0, tests)));
+    double best[2] = {1e300, 1e300};
+    for (int round = 0; round < 3; ++round)
+      for (int o = 0; o < 2; ++o) {
+        const auto t0 = std::chrono::steady_clock::now();
+        std::uint64_t sink = 0;
+        for (int i = 0; i < reps; ++i) sink += trace(s, o ? stored : sorted, ray).counters.total();
+        best[o] = std::min(best[o], seconds_since(t0) * 1e6 / reps);
+        if (sink == 0) best[o] = NAN;  // keeps the loop from being optimised away
+      }
+    r.table.add({double(k.n), double(k.depth), tests, tests_stored, best[0], best[1],
+                 best[0] * 1e3 / tests, best[1] * 1e3 / tests_stored,
+                 100 * (best[0] / best[1] - 1)});
+    same_tests &= tests == tests_stored;
+  }
+  // No check: the claim is about time, which is measured here but depends on the machine and
+  // its load, so the verdict is "not checked" (tests/analysis/experiments_test.cpp asserts the
+  // like-for-like test counts).
+  r.summary_columns = r.table.columns;
+  r.panels.push_back({"Wall time per test, traditional worst case (builtin:line)",
+                      "n (children a ray meets per node)",
+                      "ns per intersection test (primary + shadow ray)",
+                      true,
+                      false,
+                      {{"n", "ns_per_test_sorted", "sorted order", false},
+                       {"n", "ns_per_test_stored", "stored order", false}}});
+  double lo = 1e300, hi = -1e300;
+  for (const auto& row : r.table.rows) lo = std::min(lo, row[8]), hi = std::max(hi, row[8]);
+  r.findings =
+      std::string(same_tests ? "Both orders make exactly the same tests here, so the time "
+                               "difference is the ordering work. "
+                             : "**The two orders do not make the same tests here** (see the "
+                               "CSV), so the comparison is not like for like. ") +
+      "The sorted traversal takes " + fmt(lo) + "% to " + fmt(hi) +
+      "% more time than the stored one over n = 2 .. 64 (best of 3, per ray pair; the shadow "
+      "ray meets the children in reverse order, the insertion sort's worst case). A constant "
+      "factor per test, as the paper says, as long as it does not grow with the depth at "
+      "fixed n (compare the two depths of each n). Wall time is measured on this machine and "
+      "not checked: the verdict of the statement is \"not checked\".";
+  return r;
+}
+
+}  // namespace amalgam::experiments
