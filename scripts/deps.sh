@@ -10,6 +10,7 @@ packages=(
   libembree-dev
   gnuplot-nox python3 python3-matplotlib python3-numpy qemu-user
   pybind11-dev python3-dev python3-pytest python3-pandas
+  libopenmpi-dev openmpi-bin
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -32,7 +32,7 @@ struct CommonOptions {
   CLI::Option* opacity_option = nullptr;
   CLI::Option* order_option = nullptr;
   std::string camera, eye, look_at, up, fov;  ///< the view options, as given
-  int light_samples = 0;                        ///< --light-samples (0: not given)
+  int light_samples = 0;                      ///< --light-samples (0: not given)
   CameraChoice view;                          ///< set by finish()
 
   /// Registers SCENE, --set and the renderer options of docs/cli.md on `app`.
@@ -80,6 +80,7 @@ struct RenderExtras {
   bool quiet = false;
   std::string max_memory;          ///< as given (parse_bytes); empty: the machine's physical memory
   double checkpoint_every = 60.0;  ///< seconds between checkpoints during a render
+  double rank_timeout = 600.0;     ///< under mpirun: seconds a rank may hold a tile (docs/mpi.md)
 };
 
 int run_render(CommonOptions& common, const RenderExtras& extra);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -14,6 +15,9 @@
 #include "amalgam/load/load_scene.h"
 #include "amalgam/util/atomic_file.h"
 #include "common.h"
+#if defined(AMALGAM_HAVE_MPI)
+#include "mpi_render.h"
+#endif
 
 namespace amalgam::cli {
 namespace {
@@ -195,6 +199,70 @@ std::string statements_table(const std::vector<ex::Check>& checks,
   return o.str();
 }
 
+/// What the report and the files need of one experiment, as text and checks.
+struct Computed {
+  std::string csv, gp, section_plotted, section_unplotted, verdict, seconds;
+  int passed = 0;
+  std::vector<ex::Check> checks;
+
+  /// Length-prefixed fields, numbers as the bits of their doubles (a message between ranks).
+  std::string pack() const {
+    std::string out;
+    auto text = [&](const std::string& f) { out += std::to_string(f.size()) + ":" + f; };
+    auto number = [&](double v) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &v, sizeof bits);
+      text(std::to_string(bits));
+    };
+    for (const std::string* f :
+         {&csv, &gp, &section_plotted, &section_unplotted, &verdict, &seconds})
+      text(*f);
+    text(std::to_string(passed));
+    text(std::to_string(checks.size()));
+    for (const ex::Check& c : checks) {
+      text(c.what);
+      text(c.statement);
+      text(std::to_string(static_cast<int>(c.role)));
+      for (double v : {c.measured, c.predicted, c.tolerance}) number(v);
+    }
+    return out;
+  }
+  static Computed unpack(const std::string& in) {
+    Computed c;
+    std::size_t at = 0;
+    auto text = [&] {
+      const std::size_t colon = in.find(':', at);
+      if (colon == std::string::npos) throw RuntimeError("experiment: a malformed result");
+      const std::size_t len = std::stoul(in.substr(at, colon - at));
+      if (colon + 1 + len > in.size()) throw RuntimeError("experiment: a malformed result");
+      at = colon + 1 + len;
+      return in.substr(colon + 1, len);
+    };
+    auto number = [&] {
+      const std::uint64_t bits = std::stoull(text());
+      double v;
+      std::memcpy(&v, &bits, sizeof v);
+      return v;
+    };
+    for (std::string* f :
+         {&c.csv, &c.gp, &c.section_plotted, &c.section_unplotted, &c.verdict, &c.seconds})
+      *f = text();
+    c.passed = std::stoi(text());
+    const std::size_t n = std::stoul(text());
+    for (std::size_t i = 0; i < n; ++i) {
+      ex::Check k;
+      k.what = text();
+      k.statement = text();
+      k.role = static_cast<ex::Role>(std::stoi(text()));
+      k.measured = number();
+      k.predicted = number();
+      k.tolerance = number();
+      c.checks.push_back(std::move(k));
+    }
+    return c;
+  }
+};
+
 }  // namespace
 
 int run_experiment(const std::string& name, const std::string& out_dir, bool quick, int threads) {
@@ -211,12 +279,39 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
     }
   }
   const fs::path dir(out_dir);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir))
-    throw InputError("--out " + out_dir + ": cannot create the directory (" + ec.message() + ")");
-  const bool gnuplot = have_gnuplot();
-  if (!gnuplot) std::cerr << "amalgam: gnuplot is not on PATH; writing CSVs and the report only\n";
+#if defined(AMALGAM_HAVE_MPI)
+  const bool parallel = mpi::parallel(), root = !parallel || mpi::rank() == 0;
+#else
+  const bool root = true;
+#endif
+  bool gnuplot = false;
+  // Under mpirun only rank 0 writes; a failure of its directory must stop every rank.
+  std::exception_ptr failure;
+  try {
+    if (root) {
+      std::error_code ec;
+      fs::create_directories(dir, ec);
+      if (ec || !fs::is_directory(dir))
+        throw InputError("--out " + out_dir + ": cannot create the directory (" + ec.message() +
+                         ")");
+      gnuplot = have_gnuplot();
+      if (!gnuplot)
+        std::cerr << "amalgam: gnuplot is not on PATH; writing CSVs and the report only\n";
+    }
+  } catch (...) {
+#if defined(AMALGAM_HAVE_MPI)
+    if (!parallel) throw;
+    failure = std::current_exception();
+#else
+    throw;
+#endif
+  }
+#if defined(AMALGAM_HAVE_MPI)
+  if (parallel) {
+    if (const int st = mpi::agree(failure)) return st;
+    gnuplot = mpi::broadcast(gnuplot ? "1" : "0") == "1";  // the report says rank 0's
+  }
+#endif
   ex::Config config;
   config.quick = quick;
   config.threads = threads;
@@ -237,24 +332,54 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
   std::vector<ex::Check> all_checks;  // of every experiment run, for the statements table
   std::vector<std::string> ran;
   int failures = 0;
-  for (const std::string& n : todo) {
-    std::cerr << "amalgam: experiment " << n << " ..." << std::flush;
+  // One experiment's outputs as text: computed here or, under mpirun, on any rank
+  // (mpi::spread), then written by this process (rank 0) in report order.
+  auto compute = [&](const std::string& n) {
     const ex::ExperimentResult r = ex::run(n, config);
-    write_file_atomic((dir / (n + ".csv")).string(), csv(r.table));
-    write_file_atomic((dir / (n + ".gp")).string(), gnuplot_script(r, n + ".csv", n + ".png.tmp"));
+    Computed c;
+    for (const auto& k : r.checks) c.passed += k.passed();
+    c.csv = csv(r.table);
+    c.gp = gnuplot_script(r, n + ".csv", n + ".png.tmp");
+    c.section_plotted = section(r, true, gnuplot);
+    c.section_unplotted = section(r, false, gnuplot);
+    c.verdict = ex::to_string(r.verdict);
+    c.seconds = ex::fmt(r.seconds);
+    c.checks = r.checks;
+    return c;
+  };
+  auto emit = [&](const std::string& n, const Computed& c) {
+    write_file_atomic((dir / (n + ".csv")).string(), c.csv);
+    write_file_atomic((dir / (n + ".gp")).string(), c.gp);
     const bool plotted = gnuplot && plot(dir, n);
-    int passed = 0;
-    for (const auto& c : r.checks) passed += c.passed();
-    failures += static_cast<int>(r.checks.size()) - passed;
-    std::cerr << " " << ex::to_string(r.verdict) << ", " << passed << "/" << r.checks.size()
-              << " checks, " << ex::fmt(r.seconds) << " s\n";
-    std::cout << n << ": " << ex::to_string(r.verdict) << " (" << passed << "/" << r.checks.size()
+    failures += static_cast<int>(c.checks.size()) - c.passed;
+    std::cerr << " " << c.verdict << ", " << c.passed << "/" << c.checks.size() << " checks, "
+              << c.seconds << " s\n";
+    std::cout << n << ": " << c.verdict << " (" << c.passed << "/" << c.checks.size()
               << " checks)\n";
-    summary << "| [" << n << "](#" << n << ") | " << ex::to_string(r.verdict) << " | " << passed
-            << "/" << r.checks.size() << " | " << ex::fmt(r.seconds) << " |\n";
-    body << section(r, plotted, gnuplot);
-    all_checks.insert(all_checks.end(), r.checks.begin(), r.checks.end());
+    summary << "| [" << n << "](#" << n << ") | " << c.verdict << " | " << c.passed << "/"
+            << c.checks.size() << " | " << c.seconds << " |\n";
+    body << (plotted ? c.section_plotted : c.section_unplotted);
+    all_checks.insert(all_checks.end(), c.checks.begin(), c.checks.end());
     ran.push_back(n);
+  };
+#if defined(AMALGAM_HAVE_MPI)
+  if (parallel) {
+    mpi::spread(
+        static_cast<int>(todo.size()),
+        [&](int i) { return compute(todo[static_cast<std::size_t>(i)]).pack(); },
+        [&](int i, const std::string& packed) {
+          const std::string& n = todo[static_cast<std::size_t>(i)];
+          std::cerr << "amalgam: experiment " << n << " ..." << std::flush;
+          emit(n, Computed::unpack(packed));
+        });
+    if (!root) return 0;
+  } else
+#endif
+  {
+    for (const std::string& n : todo) {
+      std::cerr << "amalgam: experiment " << n << " ..." << std::flush;
+      emit(n, compute(n));
+    }
   }
   report << statements_table(all_checks, ran) << "\n" << summary.str() << "\n" << body.str();
   write_file_atomic((dir / "report.md").string(), report.str());

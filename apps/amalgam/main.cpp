@@ -12,6 +12,9 @@
 #include "amalgam/util/error.h"
 #include "amalgam/util/version.h"
 #include "common.h"
+#if defined(AMALGAM_HAVE_MPI)
+#include "mpi_render.h"
+#endif
 
 namespace {
 
@@ -37,6 +40,9 @@ namespace {
 int main(int argc, char** argv) {
   using namespace amalgam;
   std::set_terminate(on_terminate);
+#if defined(AMALGAM_HAVE_MPI)
+  cli::mpi::Session mpi_session(&argc, &argv);  // only under mpirun (docs/mpi.md)
+#endif
   CLI::App app{
       "amalgam: a ray tracer with renderable bounding volumes (amalgams), after "
       "Thompson & Fussell, 'Time Costs of Ray Tracing with Amalgams' (1991)"};
@@ -91,6 +97,12 @@ int main(int argc, char** argv) {
             return "expected seconds in [0, 1e9]";
           },
           "SECONDS"));
+
+  render
+      ->add_option("--rank-timeout", extras.rank_timeout,
+                   "under mpirun: seconds a rank may hold a tile without answering before it is "
+                   "taken as lost and its tile rendered by the others (default 600)")
+      ->check(CLI::Range(0.001, 1e9));
 
   cli::CommonOptions trace_opts;
   std::string origin, direction;

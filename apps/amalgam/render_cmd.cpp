@@ -28,6 +28,9 @@
 #include "amalgam/util/atomic_file.h"
 #include "amalgam/util/version.h"
 #include "common.h"
+#if defined(AMALGAM_HAVE_MPI)
+#include "mpi_render.h"
+#endif
 #include "progress.h"
 
 namespace amalgam::cli {
@@ -194,57 +197,92 @@ std::string format_range(const LogRange& r) {
 
 }  // namespace
 
-int run_render(CommonOptions& common, const RenderExtras& extra) {
-  common.finish();
+int run_render(CommonOptions& common, const RenderExtras& given) {
+  RenderExtras extra = given;
+#if defined(AMALGAM_HAVE_MPI)
+  const bool parallel = mpi::parallel();  // one of several ranks under mpirun (docs/mpi.md)
+  const bool root = !parallel || mpi::rank() == 0;
+#else
+  const bool parallel = false, root = true;
+#endif
+  if (!root) extra.quiet = true;  // rank 0 speaks for the job
   const RenderOptions& o = common.options;
   const std::string ckpt = extra.checkpoint.empty() ? extra.out + ".ckpt" : extra.checkpoint;
   std::optional<LogRange> given_range;
-  if (!extra.cost_range.empty()) given_range = parse_cost_range(extra.cost_range);
-  check_outputs(extra, ckpt, o);
-  const std::uint64_t asked =
-      extra.max_memory.empty() ? 0 : parse_bytes(extra.max_memory, "--max-memory");
-  if (!extra.max_memory.empty() && asked == 0)
-    throw InputError("--max-memory 0: expected a positive byte count");
-  const std::uint64_t limit = asked ? asked : physical_memory();
-  const std::uint64_t film = film_bytes(o);
-  if (film > limit)
-    throw InputError("--width " + std::to_string(o.width) + " --height " +
-                     std::to_string(o.height) + ": the film needs " + format_bytes(film) +
-                     ", more than --max-memory " + format_bytes(limit));
-  set_activity("loading and building " + common.scene);
-  PhaseStatus status(!extra.quiet);
-  SceneFileConfig budget;  // checked before the scene is built (MemoryModel)
-  budget.max_bytes = limit - film;
-  budget.limit_name = "--max-memory " + format_bytes(static_cast<double>(limit)) + " less " +
-                      format_bytes(static_cast<double>(film)) + " for the film";
-  budget.on_phase = [&](const std::string& what) {
-    set_activity(what);
-    status.phase(what);
-  };
-  LoadedScene scene = load_scene(common.scene, common.params(), budget);
-  common.prepare(scene);  // the view options, before the fingerprint takes the camera
-  check_options(scene, o);
-  const bool embree = o.tracer == TracerKind::kEmbree;
+  std::optional<LoadedScene> loaded;
+  std::string fp;
+  FilmState state;
+  bool embree = false;
 #if defined(AMALGAM_HAVE_EMBREE)
   std::unique_ptr<EmbreeScene> embree_scene;
-  if (embree) {
-    set_activity("building Embree's BVH of " + common.scene);
-    status.phase(activity());
-    embree_scene = std::make_unique<EmbreeScene>(scene, o.threads);
+#endif
+  // In a parallel render every rank prepares (options, scene) before any renders, and a rank
+  // that fails tells the others (mpi::agree) rather than leaving them waiting.
+  std::exception_ptr failure;
+  try {
+    common.finish();
+    if (!extra.cost_range.empty()) given_range = parse_cost_range(extra.cost_range);
+    if (root) check_outputs(extra, ckpt, o);  // the outputs are rank 0's
+    const std::uint64_t asked =
+        extra.max_memory.empty() ? 0 : parse_bytes(extra.max_memory, "--max-memory");
+    if (!extra.max_memory.empty() && asked == 0)
+      throw InputError("--max-memory 0: expected a positive byte count");
+    const std::uint64_t limit = asked ? asked : physical_memory();
+    const std::uint64_t film = film_bytes(o);
+    if (film > limit)
+      throw InputError("--width " + std::to_string(o.width) + " --height " +
+                       std::to_string(o.height) + ": the film needs " + format_bytes(film) +
+                       ", more than --max-memory " + format_bytes(limit));
+    set_activity("loading and building " + common.scene);
+    PhaseStatus status(!extra.quiet);
+    SceneFileConfig budget;  // checked before the scene is built (MemoryModel)
+    budget.max_bytes = limit - film;
+    budget.limit_name = "--max-memory " + format_bytes(static_cast<double>(limit)) + " less " +
+                        format_bytes(static_cast<double>(film)) + " for the film";
+    budget.on_phase = [&](const std::string& what) {
+      set_activity(what);
+      status.phase(what);
+    };
+    loaded.emplace(load_scene(common.scene, common.params(), budget));
+    common.prepare(*loaded);  // the view options, before the fingerprint takes the camera
+    check_options(*loaded, o);
+    embree = o.tracer == TracerKind::kEmbree;
+#if defined(AMALGAM_HAVE_EMBREE)
+    if (embree) {
+      set_activity("building Embree's BVH of " + common.scene);
+      status.phase(activity());
+      embree_scene = std::make_unique<EmbreeScene>(*loaded, o.threads);
+    }
+#endif
+    status.stop();
+    if (root) print_warnings(*loaded);  // after the load phases' status line
+
+    fp = fingerprint(common, *loaded);
+    if (extra.resume && root) {
+      if (!std::filesystem::exists(ckpt)) throw InputError(ckpt + ": no checkpoint to resume from");
+      state = read_checkpoint(ckpt, fp);
+      if (state.spp_done > o.spp)
+        throw InputError(ckpt + ": checkpoint holds " + std::to_string(state.spp_done) +
+                         " samples per pixel, more than --spp " + std::to_string(o.spp));
+    }
+  } catch (...) {
+    if (!parallel) throw;
+    failure = std::current_exception();
+  }
+#if defined(AMALGAM_HAVE_MPI)
+  if (parallel) {
+    if (const int st = mpi::agree(failure)) return st;
+    // Every rank must render the same image: the same scene (content hash) and options.
+    const std::string root_fp = mpi::broadcast(fp);
+    failure = nullptr;
+    if (root_fp != fp)
+      failure = std::make_exception_ptr(
+          InputError(common.scene + ": this rank loads a different scene or options than rank 0 (" +
+                     fp + " against " + root_fp + ")"));
+    if (const int st = mpi::agree(failure)) return st;
   }
 #endif
-  status.stop();
-  print_warnings(scene);  // after the load phases' status line
-
-  const std::string fp = fingerprint(common, scene);
-  FilmState state;
-  if (extra.resume) {
-    if (!std::filesystem::exists(ckpt)) throw InputError(ckpt + ": no checkpoint to resume from");
-    state = read_checkpoint(ckpt, fp);
-    if (state.spp_done > o.spp)
-      throw InputError(ckpt + ": checkpoint holds " + std::to_string(state.spp_done) +
-                       " samples per pixel, more than --spp " + std::to_string(o.spp));
-  }
+  const LoadedScene& scene = *loaded;
 
   struct sigaction sa {};
   sa.sa_handler = on_signal;
@@ -252,6 +290,29 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   sa.sa_flags = SA_RESTART;
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+#if defined(AMALGAM_HAVE_MPI)
+  // What renders a tile on this rank: amalgam's traversal or Embree, as for one process.
+  const mpi::TileRenderer tile_renderer = [&](FilmTile& t, int s0, int s1,
+                                              const std::atomic<bool>* cancel) {
+#if defined(AMALGAM_HAVE_EMBREE)
+    if (embree) return render_tile_embree(*embree_scene, o, t, s0, s1, cancel);
+#endif
+    return render_tile(scene, o, t, s0, s1, cancel);
+  };
+  if (!root) {
+    mpi::serve(tile_renderer, o, g_cancel, g_signal);
+    return 0;
+  }
+  // Rank 0, once its outputs are written (or not): the other ranks are told to stop; one that
+  // was lost ends the job with an error. Not while an exception unwinds (mpi::Session aborts).
+  struct Release {
+    bool on;
+    ~Release() {
+      if (on && std::uncaught_exceptions() == 0 && !mpi::release()) mpi::abort(1);
+    }
+  } release{parallel};
+  mpi::Stop stop;
+#endif
   Progress progress(o.spp, !extra.quiet);
   auto last_checkpoint = std::chrono::steady_clock::now();
   RenderControl control;
@@ -266,14 +327,21 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
     }
   };
   set_activity("rendering " + common.scene);
-#if defined(AMALGAM_HAVE_EMBREE)
-  RenderOutput r =
-      embree ? render_embree(*embree_scene, o, &state, control) : render(scene, o, &state, control);
-  const double embree_build = embree ? embree_scene->build_seconds() : 0.0;
-#else
-  RenderOutput r = render(scene, o, &state, control);  // finish() refused --tracer embree
-  const double embree_build = 0.0;
+  RenderOutput r;
+#if defined(AMALGAM_HAVE_MPI)
+  if (parallel) {
+    // Rounds as long as the checkpoint interval: a checkpoint is written at the end of one.
+    r = mpi::render_root(tile_renderer, o, &state, control, g_signal, extra.rank_timeout,
+                         extra.checkpoint_every, stop);
+  }
 #endif
+  double embree_build = 0.0;
+#if defined(AMALGAM_HAVE_EMBREE)
+  if (embree && !parallel) r = render_embree(*embree_scene, o, &state, control);
+  if (embree) embree_build = embree_scene->build_seconds();
+#endif
+  // (finish() refused --tracer embree in a build without Embree.)
+  if (!embree && !parallel) r = render(scene, o, &state, control);
   progress.finish();
   set_activity("writing the outputs of " + common.scene);
   // The work is done: writing its results wins over further signals (on_signal).
@@ -341,10 +409,18 @@ int run_render(CommonOptions& common, const RenderExtras& extra) {
   }
 
   if (r.interrupted) {
-    const int sig = g_signal.load();
-    std::cerr << "amalgam: interrupted by " << (sig == SIGTERM ? "SIGTERM" : "SIGINT") << ": "
-              << (r.spp > 0 ? extra.out : std::string("no image")) << " holds " << r.spp << " of "
-              << o.spp << " samples per pixel; checkpoint " << ckpt
+    int sig = g_signal.load();
+    std::string where;
+#if defined(AMALGAM_HAVE_MPI)
+    if (parallel) {
+      sig = stop.signal;
+      where = " on rank " + std::to_string(stop.signal_rank);
+      if (!stop.missing.empty()) std::cerr << "amalgam: " << stop.missing << "\n";
+    }
+#endif
+    std::cerr << "amalgam: interrupted by " << (sig == SIGTERM ? "SIGTERM" : "SIGINT") << where
+              << ": " << (r.spp > 0 ? extra.out : std::string("no image")) << " holds " << r.spp
+              << " of " << o.spp << " samples per pixel; checkpoint " << ckpt
               << " (continue with the same command and --resume)\n";
     return 1;
   }

@@ -419,6 +419,21 @@ RenderOutput render_embree(const EmbreeScene& es, const RenderOptions& o, FilmSt
   return out;
 }
 
+bool render_tile_embree(const EmbreeScene& es, const RenderOptions& o, FilmTile& tile, int s0,
+                        int s1, const std::atomic<bool>* cancel) {
+  check_embree(es, o);
+  const LoadedScene& scene = es.scene();
+  const bool interrupted = std::visit(
+      [&](const auto& h) {
+        using H = std::decay_t<decltype(h)>;
+        return render_tile_passes(scene.env.camera, o, tile, s0, s1, cancel, [&](Counters& c) {
+          return EmbreeIntegrator<H>(h, scene.env, EmbreeTracer<H>(h, es.impl(), c));
+        });
+      },
+      scene.hierarchy);
+  return !interrupted;
+}
+
 TraceOutput trace_embree(const EmbreeScene& es, const RenderOptions& o, const Ray& ray) {
   check_embree(es, o);
   const LoadedScene& scene = es.scene();

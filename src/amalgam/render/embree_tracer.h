@@ -55,6 +55,11 @@ class EmbreeScene {
 RenderOutput render_embree(const EmbreeScene& scene, const RenderOptions& options,
                            FilmState* resume = nullptr, const RenderControl& control = {});
 
+/// `render_tile` (render.h) with Embree: samples s0 .. s1 - 1 of the tile's pixels, as
+/// render_embree renders them. Returns false when `cancel` stopped it.
+bool render_tile_embree(const EmbreeScene& scene, const RenderOptions& options, FilmTile& tile,
+                        int s0, int s1, const std::atomic<bool>* cancel = nullptr);
+
 /// `trace` (render.h) with Embree: one primary ray with its shadow rays (counters: rays only).
 TraceOutput trace_embree(const EmbreeScene& scene, const RenderOptions& options, const Ray& ray);
 

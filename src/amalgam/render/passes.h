@@ -37,6 +37,46 @@ inline void add_sample(PixelAov& a, const SampleResult& r) {
   }
 }
 
+/// Adds samples s0 .. s1 - 1 of pixel (x, y) to its running sums `sum`, `tests` and `aov`, in
+/// sample order: the one per-pixel loop of render_passes and render_tile_passes, so a pixel's
+/// bytes do not depend on which of them rendered it.
+template <class Integrator>
+inline void render_pixel(const Camera& camera, const RenderOptions& o, int x, int y, int s0, int s1,
+                         Integrator& integrator, Counters& counters, CostDistribution& per_primary,
+                         Vec3& sum_io, std::uint64_t& tests_io, PixelAov& aov_io) {
+  const bool stratified = o.sampler == PixelSampler::kStratified;
+  const std::size_t pix = static_cast<std::size_t>(y) * o.width + x;
+  const std::uint64_t pixel_key = hash_combine(o.seed, pix);
+  const std::uint64_t scramble = hash_combine(pixel_key, 0x50b01);
+  Vec3 sum = sum_io;
+  std::uint64_t tests = 0;
+  PixelAov aov = aov_io;
+  for (int s = s0; s < s1; ++s) {
+    const std::uint64_t key = hash_combine(pixel_key, static_cast<std::uint64_t>(s));
+    float jx, jy;
+    if (stratified) {
+      std::tie(jx, jy) = scrambled_sobol_2d(static_cast<std::uint32_t>(s), scramble);
+    } else {
+      Sampler jitter(hash_combine(key, 0x6a177e5));
+      jx = jitter.next();
+      jy = jitter.next();
+    }
+    const float fx = static_cast<float>(x) + jx;
+    const float fy = static_cast<float>(y) + jy;
+    const Ray ray = camera.generate(fx, fy, o.width, o.height);
+    const std::uint64_t before = counters.total();
+    const SampleResult r = integrator.li(ray, key);
+    sum += r.colour;
+    add_sample(aov, r);
+    const std::uint64_t cost = counters.total() - before;
+    per_primary.add(cost);
+    tests += cost;
+  }
+  sum_io = sum;
+  tests_io += tests;
+  aov_io = aov;
+}
+
 /// Adds samples st.spp_done .. o.spp - 1 to `st` (sized for o.width x o.height), in passes of
 /// whole samples per pixel over 8x8 tiles on o.threads threads (0: all). Pixel (x, y),
 /// sample s uses the random stream hash(o.seed, y * width + x, s), so the result does not
@@ -55,9 +95,8 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
   const std::size_t pixels = static_cast<std::size_t>(o.width) * o.height;
   // Samples per pass: whole samples for every pixel, about 2^16 primary rays per pass so that
   // small images do not pay for many passes and large ones can stop quickly.
-  const int per_pass = std::max(1, static_cast<int>(65536 / std::max<std::size_t>(pixels, 1)));
+  const int per_pass = samples_per_pass(pixels);
   tbb::task_arena arena(render_threads(o));
-  const bool stratified = o.sampler == PixelSampler::kStratified;
   std::vector<Vec3> pass_sum;
   std::vector<std::uint64_t> pass_tests;
   std::vector<PixelAov> pass_aov;
@@ -70,50 +109,23 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
     tbb::enumerable_thread_specific<ThreadState> states;
     std::atomic<bool> stopped{false};
     arena.execute([&] {
-      tbb::parallel_for(
-          tbb::blocked_range2d<int>(0, o.height, 8, 0, o.width, 8),
-          [&](const tbb::blocked_range2d<int>& r) {
-            if (control.cancel && control.cancel->load(std::memory_order_relaxed)) {
-              stopped.store(true, std::memory_order_relaxed);
-              return;
-            }
-            ThreadState& ts = states.local();
-            auto integrator = make(ts.counters);
-            for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
-              for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
-                const std::size_t pix = static_cast<std::size_t>(y) * o.width + x;
-                const std::uint64_t pixel_key = hash_combine(o.seed, pix);
-                const std::uint64_t scramble = hash_combine(pixel_key, 0x50b01);
-                Vec3 sum = pass_sum[pix];
-                std::uint64_t tests = 0;
-                PixelAov aov = pass_aov[pix];
-                for (int s = s0; s < s1; ++s) {
-                  const std::uint64_t key = hash_combine(pixel_key, static_cast<std::uint64_t>(s));
-                  float jx, jy;
-                  if (stratified) {
-                    std::tie(jx, jy) = scrambled_sobol_2d(static_cast<std::uint32_t>(s), scramble);
-                  } else {
-                    Sampler jitter(hash_combine(key, 0x6a177e5));
-                    jx = jitter.next();
-                    jy = jitter.next();
-                  }
-                  const float fx = static_cast<float>(x) + jx;
-                  const float fy = static_cast<float>(y) + jy;
-                  const Ray ray = camera.generate(fx, fy, o.width, o.height);
-                  const std::uint64_t before = ts.counters.total();
-                  const SampleResult r = integrator.li(ray, key);
-                  sum += r.colour;
-                  add_sample(aov, r);
-                  const std::uint64_t cost = ts.counters.total() - before;
-                  ts.per_primary.add(cost);
-                  tests += cost;
-                }
-                pass_sum[pix] = sum;
-                pass_tests[pix] += tests;
-                pass_aov[pix] = aov;
-              }
-            }
-          });
+      tbb::parallel_for(tbb::blocked_range2d<int>(0, o.height, 8, 0, o.width, 8),
+                        [&](const tbb::blocked_range2d<int>& r) {
+                          if (control.cancel && control.cancel->load(std::memory_order_relaxed)) {
+                            stopped.store(true, std::memory_order_relaxed);
+                            return;
+                          }
+                          ThreadState& ts = states.local();
+                          auto integrator = make(ts.counters);
+                          for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
+                            for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+                              const std::size_t pix = static_cast<std::size_t>(y) * o.width + x;
+                              render_pixel(camera, o, x, y, s0, s1, integrator, ts.counters,
+                                           ts.per_primary, pass_sum[pix], pass_tests[pix],
+                                           pass_aov[pix]);
+                            }
+                          }
+                        });
     });
     if (stopped.load()) return true;  // the pass is incomplete: discard it
     st.sum.swap(pass_sum);
@@ -126,6 +138,49 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
     st.spp_done = s1;
     if (control.on_pass) control.on_pass(st);
     if (control.cancel && control.cancel->load() && st.spp_done < o.spp) return true;
+  }
+  return false;
+}
+
+/// Adds samples s0 .. s1 - 1 to the pixels of `tile` (a rectangle of an o.width x o.height
+/// image, its sums continuing from what it holds) on o.threads threads, in 8x8 blocks, with the
+/// per-pixel loop of render_passes: a tile rendered here holds the same bytes as the same pixels
+/// of a render_passes render. Its counters and per_primary receive the tests of these samples.
+/// Returns whether `cancel` stopped it (the tile is then incomplete and must be discarded).
+template <class MakeIntegrator>
+bool render_tile_passes(const Camera& camera, const RenderOptions& o, FilmTile& tile, int s0,
+                        int s1, const std::atomic<bool>* cancel, MakeIntegrator&& make) {
+  struct ThreadState {
+    Counters counters;
+    CostDistribution per_primary;
+  };
+  const TileRect& t = tile.rect;
+  tbb::task_arena arena(render_threads(o));
+  tbb::enumerable_thread_specific<ThreadState> states;
+  std::atomic<bool> stopped{false};
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range2d<int>(t.y0, t.y1, 8, t.x0, t.x1, 8),
+                      [&](const tbb::blocked_range2d<int>& r) {
+                        if (cancel && cancel->load(std::memory_order_relaxed)) {
+                          stopped.store(true, std::memory_order_relaxed);
+                          return;
+                        }
+                        ThreadState& ts = states.local();
+                        auto integrator = make(ts.counters);
+                        for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
+                          for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+                            const std::size_t i =
+                                static_cast<std::size_t>(y - t.y0) * (t.x1 - t.x0) + (x - t.x0);
+                            render_pixel(camera, o, x, y, s0, s1, integrator, ts.counters,
+                                         ts.per_primary, tile.sum[i], tile.tests[i], tile.aov[i]);
+                          }
+                        }
+                      });
+  });
+  if (stopped.load()) return true;
+  for (const ThreadState& ts : states) {
+    tile.counters.merge(ts.counters);
+    tile.per_primary.merge(ts.per_primary);
   }
   return false;
 }

@@ -115,6 +115,55 @@ RenderOutput render(const LoadedScene& scene, const Environment& env, const Rend
   return out;
 }
 
+int samples_per_pass(std::size_t pixels) {
+  return std::max(1, static_cast<int>(65536 / std::max<std::size_t>(pixels, 1)));
+}
+
+FilmTile cut_tile(const FilmState& st, const TileRect& r) {
+  FilmTile t;
+  t.rect = r;
+  t.sum.reserve(r.pixels());
+  t.tests.reserve(r.pixels());
+  t.aov.reserve(r.pixels());
+  for (int y = r.y0; y < r.y1; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * st.width;
+    t.sum.insert(t.sum.end(), st.sum.begin() + row + r.x0, st.sum.begin() + row + r.x1);
+    t.tests.insert(t.tests.end(), st.tests.begin() + row + r.x0, st.tests.begin() + row + r.x1);
+    t.aov.insert(t.aov.end(), st.aov.begin() + row + r.x0, st.aov.begin() + row + r.x1);
+  }
+  return t;
+}
+
+void paste_tile(const FilmTile& t, FilmState& st) {
+  const TileRect& r = t.rect;
+  const std::size_t w = static_cast<std::size_t>(r.x1 - r.x0);
+  for (int y = r.y0; y < r.y1; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * st.width + r.x0;
+    const std::size_t at = static_cast<std::size_t>(y - r.y0) * w;
+    std::copy_n(t.sum.begin() + at, w, st.sum.begin() + row);
+    std::copy_n(t.tests.begin() + at, w, st.tests.begin() + row);
+    std::copy_n(t.aov.begin() + at, w, st.aov.begin() + row);
+  }
+}
+
+bool render_tile(const LoadedScene& scene, const RenderOptions& o, FilmTile& tile, int s0, int s1,
+                 const std::atomic<bool>* cancel) {
+  require_amalgam_tracer(o);
+  const TileRect& r = tile.rect;
+  if (r.x0 < 0 || r.y0 < 0 || r.x1 > o.width || r.y1 > o.height || r.x0 >= r.x1 || r.y0 >= r.y1 ||
+      tile.sum.size() != r.pixels() || tile.tests.size() != r.pixels() ||
+      tile.aov.size() != r.pixels() || s0 < 0 || s1 < s0)
+    throw InputError("render_tile: the tile does not fit the image of these options");
+#if defined(AMALGAM_BUILD_AVX2_COPY)
+  const bool interrupted = active_simd() == Simd::kAvx2
+                               ? detail::render_tile_avx2(scene, o, tile, s0, s1, cancel)
+                               : detail::render_tile_portable(scene, o, tile, s0, s1, cancel);
+#else
+  const bool interrupted = detail::render_tile_portable(scene, o, tile, s0, s1, cancel);
+#endif
+  return !interrupted;
+}
+
 TraceOutput trace(const LoadedScene& scene, const RenderOptions& o, const Ray& ray) {
   check_options(scene, o);
   require_amalgam_tracer(o);

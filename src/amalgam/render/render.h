@@ -62,6 +62,29 @@ struct FilmState {
   CostDistribution per_primary;
 };
 
+/// A rectangle of pixels [x0, x1) x [y0, y1) of an image.
+struct TileRect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  std::size_t pixels() const { return static_cast<std::size_t>(x1 - x0) * (y1 - y0); }
+};
+
+/// The running sums of a rectangle of a FilmState (row-major within it), and the counters and
+/// cost distribution of the samples added to it since it was cut: the unit of work handed to
+/// another process (apps/amalgam/mpi_render.h).
+struct FilmTile {
+  TileRect rect;
+  std::vector<Vec3> sum;
+  std::vector<std::uint64_t> tests;
+  std::vector<PixelAov> aov;
+  Counters counters;
+  CostDistribution per_primary;
+};
+
+/// The pixels of `rect` of `st` (zero counters), to continue rendering them with render_tile.
+FilmTile cut_tile(const FilmState& st, const TileRect& rect);
+/// Copies the pixels of `tile` into `st` (counters are not touched: the caller merges them).
+void paste_tile(const FilmTile& tile, FilmState& st);
+
 /// Hooks into a running render.
 struct RenderControl {
   /// When it becomes true, the render stops at the next tile; the unfinished pass of samples is
@@ -84,6 +107,18 @@ RenderOutput render(const LoadedScene& scene, const RenderOptions& options,
 /// scene.env, the hierarchy and its bake are shared (e.g. `chosen_view`, load/load_scene.h).
 RenderOutput render(const LoadedScene& scene, const Environment& env, const RenderOptions& options,
                     FilmState* resume = nullptr, const RenderControl& control = {});
+
+/// Adds samples s0 .. s1 - 1 to the pixels of `tile` (cut from a film of options.width x
+/// options.height), with the sampling and per-pixel sample order of `render`: rendering every
+/// tile of an image over the same sample ranges gives the bytes of `render` (and its counters,
+/// merged). options.tracer must be kAmalgam. Returns false when `cancel` stopped it (the tile
+/// is then incomplete).
+bool render_tile(const LoadedScene& scene, const RenderOptions& options, FilmTile& tile, int s0,
+                 int s1, const std::atomic<bool>* cancel = nullptr);
+
+/// Samples per pixel one pass of `render` adds to an image of `pixels` pixels: about 2^16 primary
+/// rays per pass, at least one sample.
+int samples_per_pass(std::size_t pixels);
 
 /// Prepares `st` for a render of `options`: a fresh film when it holds none, else checks that
 /// the saved one fits (InputError). Shared by `render` and `render_embree`.

@@ -15,6 +15,12 @@ bool render_passes_portable(const LoadedScene& scene, const Environment& env,
 bool render_passes_avx2(const LoadedScene& scene, const Environment& env, const RenderOptions& o,
                         FilmState& st, const RenderControl& control);
 
+/// render_tile's pass (passes.h, render_tile_passes); returns whether it was interrupted.
+bool render_tile_portable(const LoadedScene& scene, const RenderOptions& o, FilmTile& tile, int s0,
+                          int s1, const std::atomic<bool>* cancel);
+bool render_tile_avx2(const LoadedScene& scene, const RenderOptions& o, FilmTile& tile, int s0,
+                      int s1, const std::atomic<bool>* cancel);
+
 /// Traces one primary sample along `ray` into `out` (counters, hit, colour).
 void trace_portable(const LoadedScene& scene, const RenderOptions& o, const Ray& ray,
                     TraceOutput& out);

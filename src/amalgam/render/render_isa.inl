@@ -58,6 +58,18 @@ bool AMALGAM_ISA_SUFFIXED(render_passes)(const LoadedScene& scene, const Environ
   return interrupted;
 }
 
+bool AMALGAM_ISA_SUFFIXED(render_tile)(const LoadedScene& scene, const RenderOptions& o,
+                                       FilmTile& tile, int s0, int s1,
+                                       const std::atomic<bool>* cancel) {
+  bool interrupted = false;
+  dispatch(scene, o, [&](const auto& h, auto lod, auto op, auto order) {
+    using I = Integrator<std::decay_t<decltype(h)>, decltype(lod), decltype(op), decltype(order)>;
+    interrupted = render_tile_passes(scene.env.camera, o, tile, s0, s1, cancel,
+                                     [&](Counters& c) { return I(h, scene.env, lod, c); });
+  });
+  return interrupted;
+}
+
 void AMALGAM_ISA_SUFFIXED(trace)(const LoadedScene& scene, const RenderOptions& o, const Ray& ray,
                                  TraceOutput& out) {
   dispatch(scene, o, [&](const auto& h, auto lod, auto op, auto order) {
