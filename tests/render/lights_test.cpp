@@ -133,6 +133,16 @@ TEST(SizedLights, SceneFileErrorsNameTheLight) {
             std::string::npos);
 }
 
+/// scenes/field.json seen from above: at footprint 16 its Wusons render as amalgams.
+LoadedScene field_from_above() {
+  Params none("scenes/field.json");
+  LoadedScene s = load_scene(AMALGAM_SOURCE_DIR "/scenes/field.json", none);
+  CameraChoice aerial;
+  aerial.eye = Vec3{0, 120, 160}, aerial.look_at = Vec3{0, 0, 0};
+  choose_camera(s, aerial);
+  return s;
+}
+
 TEST(PrefilteredOpacity, StochasticForCameraRaysBlendedForShadowRays) {
   const PrefilteredOpacity p;
   const StochasticOpacity s;
@@ -148,11 +158,7 @@ TEST(PrefilteredOpacity, HasTheExpectationOfStochasticShadowsWithLessNoise) {
   // The field from above at footprint 16: Wusons render as amalgams for shadow rays. The
   // camera rays' decisions are the same under both models, so the prefiltered image is the
   // stochastic one with each shadow ray's decision replaced by its expectation.
-  Params none("scenes/field.json");
-  LoadedScene s = load_scene(AMALGAM_SOURCE_DIR "/scenes/field.json", none);
-  CameraChoice aerial;
-  aerial.eye = Vec3{0, 120, 160}, aerial.look_at = Vec3{0, 0, 0};
-  choose_camera(s, aerial);
+  const LoadedScene s = field_from_above();
   RenderOptions o;
   o.footprint = 16.0f, o.width = 32, o.height = 24, o.threads = 2;
   auto image = [&](OpacityKind k, int spp, std::uint64_t seed) {
@@ -184,11 +190,7 @@ TEST(CompositeOpacity, HasTheDeterministicImageWithOneShadowRayPerLightPerSample
   // camera ray crosses as the deterministic model does (and stops when it is saturated), but
   // traces the shadow rays of one member only: the same expected image, at most one shadow
   // ray per sample (the deterministic model: one per translucent member as well).
-  Params none("scenes/field.json");
-  LoadedScene s = load_scene(AMALGAM_SOURCE_DIR "/scenes/field.json", none);
-  CameraChoice aerial;
-  aerial.eye = Vec3{0, 120, 160}, aerial.look_at = Vec3{0, 0, 0};
-  choose_camera(s, aerial);
+  const LoadedScene s = field_from_above();
   ASSERT_EQ(s.env.lights.size(), 1u);
   RenderOptions o;
   o.footprint = 16.0f, o.width = 32, o.height = 24, o.threads = 2, o.seed = 9;

@@ -2,13 +2,28 @@
 /// \file Helpers shared by the experiments (analysis/experiments/<name>.cpp, one file per
 /// experiment): scene loading and tracing of the default (centre) ray.
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <string>
 
 #include "amalgam/analysis/experiments.h"
 #include "amalgam/render/render.h"
 
 namespace amalgam::experiments::detail {
+
+/// Running mean of samples with its standard error.
+struct Mean {
+  double sum = 0, sum2 = 0;
+  int count = 0;
+  void add(double v) { sum += v, sum2 += v * v, ++count; }
+  double mean() const { return sum / count; }
+  double se() const {
+    const double m = mean();
+    const double var = std::max(0.0, (sum2 / count - m * m)) * count / std::max(1, count - 1);
+    return std::sqrt(var / count);
+  }
+};
 
 /// Loads builtin:`name` with the given key=value parameters.
 inline LoadedScene scene(const std::string& name,

@@ -23,18 +23,6 @@ double safe(const std::function<double()>& f) {
   }
 }
 
-struct Mean {
-  double sum = 0, sum2 = 0;
-  int count = 0;
-  void add(double v) { sum += v, sum2 += v * v, ++count; }
-  double mean() const { return sum / count; }
-  double se() const {
-    const double m = mean();
-    const double var = std::max(0.0, (sum2 / count - m * m)) * count / std::max(1, count - 1);
-    return std::sqrt(var / count);
-  }
-};
-
 }  // namespace
 
 ExperimentResult expected(const Config& c) {

@@ -13,22 +13,6 @@
 namespace amalgam::experiments {
 using namespace detail;
 
-namespace {
-
-struct Mean {
-  double sum = 0, sum2 = 0;
-  int count = 0;
-  void add(double v) { sum += v, sum2 += v * v, ++count; }
-  double mean() const { return sum / count; }
-  double se() const {
-    const double m = mean();
-    const double var = std::max(0.0, (sum2 / count - m * m)) * count / std::max(1, count - 1);
-    return std::sqrt(var / count);
-  }
-};
-
-}  // namespace
-
 ExperimentResult traversed(const Config& c) {
   ExperimentResult r;
   r.title = "Eqs. 4-8 as the paper counts: objects traversed in sorted order";
