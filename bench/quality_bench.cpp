@@ -245,9 +245,11 @@ Run run_once(const Args& a, const std::string& kind, float k, int spp, std::uint
   o.spp = spp, o.seed = seed;
   if (k > 0) o.footprint = k;
   if (kind == "scale-sensitive") o.opacity = *parse_opacity(a.opacity);
-  if (a.light_samples > 0)
-    for (Light& l : s.env.lights)
-      if (l.sized()) l.samples = a.light_samples;
+  if (a.light_samples > 0) {
+    CameraChoice samples;  // the view as loaded, with --light-samples
+    samples.light_samples = a.light_samples;
+    s.env = chosen_view(s, samples);
+  }
   Run r;
   if (kind == "embree") {
     const auto& h = std::get<InstancedHierarchy>(s.hierarchy);

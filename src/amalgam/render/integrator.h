@@ -53,9 +53,7 @@ class Integrator {
     const Vec3 wo = -primary.dir;
     float through = 1.0f;
     if constexpr (Opacity::kBlends) {
-      std::sort(translucent_.begin(), translucent_.end(), [](const auto& a, const auto& b) {
-        return a.t < b.t || (a.t == b.t && a.id < b.id);
-      });
+      sort_front_to_back();
       for (const TranslucentHit& a : translucent_) {
         const Appearance app = h_.appearance(a.id);
         const float w = through * a.opacity;
@@ -105,6 +103,13 @@ class Integrator {
                                   app.shading == Shading::kCloud);
   }
 
+  /// The translucent amalgams met, front to back (ties by id: the same order on any thread).
+  void sort_front_to_back() {
+    std::sort(translucent_.begin(), translucent_.end(), [](const auto& a, const auto& b) {
+      return a.t < b.t || (a.t == b.t && a.id < b.id);
+    });
+  }
+
   /// li() under CompositeOpacity: the translucent amalgams in front of the hit blended front
   /// to back with weights w_k = T_k a_k (the hit, or the background, gets what is left), each
   /// shaded without shadows (U_k, no rays); then one member j, chosen with probability
@@ -112,9 +117,7 @@ class Integrator {
   /// counts w_j D_j / p_j. Its expectation is sum_k w_k D_k, the deterministic model's image,
   /// with one set of shadow rays per sample instead of one per member.
   SampleResult li_composite(const Ray& primary, std::uint64_t key, const TraceHit& hit) {
-    std::sort(translucent_.begin(), translucent_.end(), [](const auto& a, const auto& b) {
-      return a.t < b.t || (a.t == b.t && a.id < b.id);
-    });
+    sort_front_to_back();
     const float t_end = hit.kind == TraceHit::Kind::kNone ? kInfinity : hit.t;
     SampleResult r{{}, hit};
     const Vec3 wo = -primary.dir;
