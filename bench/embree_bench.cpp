@@ -7,13 +7,17 @@
 //
 // Ours: Traversal<ExplicitHierarchy, TraditionalLod, kStochastic, sorted, NullCounters>;
 // `intersect` for closest hit, `transmittance` for any hit, over `build_explicit` with its
-// default BuildConfig. Embree: rtcIntersect1 / rtcOccluded1 (single-ray API), scene built
-// with RTC_BUILD_QUALITY_HIGH and default scene flags (no RTC_SCENE_FLAG_ROBUST), one
-// triangle geometry holding the same triangle soup (3 vertices per triangle, shared buffers).
+// default BuildConfig. Embree: rtcIntersect1 / rtcOccluded1 (single-ray API) on two scenes
+// over one triangle geometry holding the same triangle soup (3 vertices per triangle, shared
+// buffers): Embree's default configuration (what `rtcCommitScene` builds when nothing is set:
+// RTC_BUILD_QUALITY_MEDIUM, no scene flags: BVH8 + Triangle4, Moeller-Trumbore, not
+// watertight) and, beside it, the same with RTC_SCENE_FLAG_ROBUST (Pluecker test, robust box
+// tests: like-for-like with our watertight triangle test). Builds are compared with the default.
 //
-// Each ray benchmark traces the whole ray set with ours and then with Embree in every
-// iteration, timing each separately, so both see the same machine state; the counters give
-// Mrays/s of each, per thread, and speed_ratio = ours / Embree (> 1: ours is faster).
+// Each ray benchmark traces the whole ray set with ours, then with Embree (default), then with
+// Embree (robust) in every iteration, timing each separately, so all see the same machine
+// state; the counters give Mrays/s of each, per thread, speed_ratio = ours / Embree default
+// and speed_ratio_robust = ours / Embree robust (> 1: ours is faster).
 // Multi-threaded variants split the rays over a TBB arena of T threads for both.
 //
 // Before timing, every ray set is traced once by both and compared: same hit/miss (or
@@ -114,7 +118,8 @@ void embree_error(void*, RTCError code, const char* str) {
 struct EmbreeScene {
   RTCDevice device = nullptr;
   RTCGeometry geometry = nullptr;
-  RTCScene scene = nullptr;
+  RTCScene scene = nullptr;            ///< default configuration
+  RTCScene robust = nullptr;           ///< RTC_SCENE_FLAG_ROBUST
   std::vector<float> vertices;         ///< 3 per triangle, plus one float of padding at the end
   std::vector<std::uint32_t> indices;  ///< 0, 1, 2, 3, ...
   MemoryMonitor monitor;
@@ -136,15 +141,23 @@ struct EmbreeScene {
                                0, 3 * sizeof(std::uint32_t), prims.size());
     rtcCommitGeometry(geometry);
   }
-  /// Builds a fresh scene over the geometry; returns the seconds rtcCommitScene took.
+  /// Builds a fresh scene over the geometry in Embree's default configuration (nothing set:
+  /// RTC_BUILD_QUALITY_MEDIUM, RTC_SCENE_FLAG_NONE); returns the seconds rtcCommitScene took.
   double commit() {
     if (scene) rtcReleaseScene(scene);
     scene = rtcNewScene(device);
-    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
     rtcAttachGeometry(scene, geometry);
     const auto t0 = Clock::now();
     rtcCommitScene(scene);
     return std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+  /// The same geometry with RTC_SCENE_FLAG_ROBUST (built once, for the ray benchmarks).
+  void commit_robust() {
+    if (robust) return;
+    robust = rtcNewScene(device);
+    rtcSetSceneFlags(robust, RTC_SCENE_FLAG_ROBUST);
+    rtcAttachGeometry(robust, geometry);
+    rtcCommitScene(robust);
   }
   /// Bytes of the input buffers (shared, so not seen by the monitor).
   std::size_t buffer_bytes() const {
@@ -152,6 +165,7 @@ struct EmbreeScene {
   }
   ~EmbreeScene() {
     if (scene) rtcReleaseScene(scene);
+    if (robust) rtcReleaseScene(robust);
     rtcReleaseGeometry(geometry);
     rtcReleaseDevice(device);
   }
@@ -197,18 +211,18 @@ struct LoadedBenchScene {
   RaySet primary, shadow, random;
 };
 
-float embree_closest(const EmbreeScene& s, const RTCRay& r, RTCIntersectContext* ctx) {
+float embree_closest(RTCScene scene, const RTCRay& r, RTCIntersectContext* ctx) {
   RTCRayHit rh;
   rh.ray = r;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(s.scene, ctx, &rh);
+  rtcIntersect1(scene, ctx, &rh);
   return rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? kInfinity : rh.ray.tfar;
 }
 
-bool embree_occluded(const EmbreeScene& s, const RTCRay& r, RTCIntersectContext* ctx) {
+bool embree_occluded(RTCScene scene, const RTCRay& r, RTCIntersectContext* ctx) {
   RTCRay ray = r;
-  rtcOccluded1(s.scene, ctx, &ray);
+  rtcOccluded1(scene, ctx, &ray);
   return ray.tfar < 0.0f;
 }
 
@@ -224,12 +238,12 @@ void check_agreement(LoadedBenchScene& sc, RaySet& set, bool any_hit, const char
     ++a.rays;
     if (any_hit) {
       const bool o = tr.transmittance(set.ours[i], i) == 0.0f;
-      const bool e = embree_occluded(*sc.embree, set.embree[i], &ctx);
+      const bool e = embree_occluded(sc.embree->scene, set.embree[i], &ctx);
       hits += o;
       if (o == e) ++a.same_hit, ++a.same_t;
     } else {
       const TraceHit h = tr.intersect(set.ours[i], i);
-      const float te = embree_closest(*sc.embree, set.embree[i], &ctx);
+      const float te = embree_closest(sc.embree->scene, set.embree[i], &ctx);
       const bool o = h.kind != TraceHit::Kind::kNone, e = te != kInfinity;
       hits += o;
       if (o != e) continue;
@@ -392,33 +406,43 @@ void bm_rays(benchmark::State& state, SceneSpec spec, RayKindB kind, int threads
     }
     sink += hits;
   };
-  auto embree = [&](std::size_t b, std::size_t e) {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    std::uint64_t hits = 0;
-    for (std::size_t i = b; i < e; ++i) {
-      if (any_hit)
-        hits += embree_occluded(*sc.embree, set.embree[i], &ctx);
-      else
-        hits += embree_closest(*sc.embree, set.embree[i], &ctx) != kInfinity;
-    }
-    sink += hits;
+  sc.embree->commit_robust();
+  auto embree_in = [&](RTCScene scene) {
+    return [&, scene](std::size_t b, std::size_t e) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      std::uint64_t hits = 0;
+      for (std::size_t i = b; i < e; ++i) {
+        if (any_hit)
+          hits += embree_occluded(scene, set.embree[i], &ctx);
+        else
+          hits += embree_closest(scene, set.embree[i], &ctx) != kInfinity;
+      }
+      sink += hits;
+    };
   };
+  const auto embree = embree_in(sc.embree->scene), robust = embree_in(sc.embree->robust);
 
-  double t_ours = 0, t_embree = 0;
+  double t_ours = 0, t_embree = 0, t_robust = 0;
   for (auto _ : state) {
     const auto t0 = Clock::now();
     run_split(arena.get(), n, ours);
     const auto t1 = Clock::now();
     run_split(arena.get(), n, embree);
     const auto t2 = Clock::now();
+    run_split(arena.get(), n, robust);
+    const auto t3 = Clock::now();
     t_ours += std::chrono::duration<double>(t1 - t0).count();
     t_embree += std::chrono::duration<double>(t2 - t1).count();
-    state.SetIterationTime(std::chrono::duration<double>(t2 - t0).count());
+    t_robust += std::chrono::duration<double>(t3 - t2).count();
+    state.SetIterationTime(std::chrono::duration<double>(t3 - t0).count());
   }
   benchmark::DoNotOptimize(sink.load());
   const double rays = static_cast<double>(n) * static_cast<double>(state.iterations());
   const double m_ours = rays / t_ours * 1e-6, m_embree = rays / t_embree * 1e-6;
+  const double m_robust = rays / t_robust * 1e-6;
+  state.counters["embree_robust_Mrays_s"] = m_robust;
+  state.counters["speed_ratio_robust"] = m_ours / m_robust;
   state.counters["rays"] = static_cast<double>(n);
   state.counters["threads"] = threads;
   state.counters["triangles"] = static_cast<double>(sc.prims.size());
