@@ -62,7 +62,11 @@ class WideWalk {
   /// Pushing a node's hit children farthest-first makes the pops the same depth-first,
   /// nearest-first order as the recursion of the generic walk; a popped entry beyond the
   /// closest hit is skipped, as the generic walk breaks there (every later sibling is farther
-  /// still). The stack is `stack_[0, sp)`, grown before a node's children are pushed.
+  /// still). The nearest hit child is not pushed: the walk goes on with it at once (what the
+  /// pop right after the pushes would have given: its entry is <= tmax, as the box test
+  /// checked, and nothing between its test and its entry changes tmax or `done`), so a node
+  /// with one hit child costs no stack traffic. The stack is `stack_[0, sp)`, grown before a
+  /// node's children are pushed.
   template <bool kZeroAxes>
   void loop(State& s, const WideNodes& w) {
     // The per-ray constants and the stack's base and capacity as locals: members would be
@@ -70,81 +74,128 @@ class WideWalk {
     const WideRay wr = WideRay::of(s.ray);
     tri_ = wr.pre;  // for the primitives of mixed leaves (`primitive`)
     StackItem* st = stack_.data();
-    std::size_t cap = stack_.size(), sp = 1;
-    while (sp > 0 && !s.done) {
-      const StackItem it = st[--sp];
-      if (it.t > s.ray.tmax) continue;
+    std::size_t cap = stack_.size(), sp = 0;
+    StackItem it = st[0];
+    for (;;) {
       s.counters.count_reached(s.kind);
+      bool rendered = false;
       if constexpr (State::kMayRender) {
         if (s.lod.may_render(it.level)) {
           const Bbox b = s.h.bounds(it.node);
           if (s.renders(b, it.level, it.t)) {
             s.render_amalgam(it.node, it.level, b, it.t);
-            continue;
+            rendered = true;
           }
         }
       }
-      expand<kZeroAxes>(s, w, wr, it.node, it.level, st, cap, sp);
+      if (!rendered && expand<kZeroAxes>(s, w, wr, it, st, cap, sp)) continue;
+      do {
+        if (sp == 0 || s.done) return;
+        it = st[--sp];
+      } while (it.t > s.ray.tmax);
     }
   }
 
   /// Always inlined into the pop loop: as a call per node it cost register saves and restores
   /// and the box kernel's per-ray constants were set up again for every node (inlining it, with
   /// the pushes straight onto the stack below, took the engine primary rays from 2 578 to
-  /// 2 133 instructions per ray; docs/benchmarks.md).
+  /// 2 133 instructions per ray; docs/benchmarks.md). Returns true when `it` is now the nearest
+  /// hit child, to be entered next (the other hit children are on the stack).
   template <bool kZeroAxes>
-  [[gnu::always_inline]] void expand(State& s, const WideNodes& w, const WideRay& wr,
-                                     std::uint32_t node, int level, StackItem*& st,
-                                     std::size_t& cap, std::size_t& sp) {
-    const WideHeader hd = w.headers[node];
-    const int cl = level + 1;
+  [[gnu::always_inline]] bool expand(State& s, const WideNodes& w, const WideRay& wr, StackItem& it,
+                                     StackItem*& st, std::size_t& cap, std::size_t& sp) {
+    const WideHeader hd = w.headers[it.node];
+    const int cl = it.level + 1;
     const int count = hd.count;
     if (hd.leaf == kWideTriangleLeaf) {
       leaf_triangles(s, w, wr, hd, cl);
-      return;
+      return false;
     }
     if (hd.leaf) {
       for (int i = 0; i < count; ++i) {
         s.counters.count_test(s.kind, ObjectKind::kPrimitive, cl);
         primitive(s, hd.first + static_cast<std::uint32_t>(i), cl);
-        if (s.done) return;
+        if (s.done) return false;
       }
-      return;
+      return false;
     }
     const ObjectKind ok = s.object_kind(cl);
     for (int i = 0; i < count; ++i) s.counters.count_test(s.kind, ok, cl);
+    const WideBox4* blk = w.blocks.data() + hd.block;
+    // One kernel call for the whole node (arity <= 8 with AVX2, <= 4 otherwise): a single hit
+    // child is entered at once, without touching the stack.
+#if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
+    constexpr int kOneCall = 2 * kWideLanes;
+#else
+    constexpr int kOneCall = kWideLanes;
+#endif
+    if (count <= kOneCall) {
+      alignas(32) float t[kOneCall];
+      unsigned mask;
+#if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
+      if (count > kWideLanes)
+        mask = intersect_wide8<kZeroAxes>(blk[0], blk[1], wr, s.ray.tmin, s.ray.tmax, count, t);
+      else
+#endif
+        mask = intersect_wide4<kZeroAxes>(*blk, wr, s.ray.tmin, s.ray.tmax, count, t);
+      if (mask == 0) return false;
+      if ((mask & (mask - 1)) == 0) {
+        const int lane = std::countr_zero(mask);
+        it = {t[lane], hd.first + static_cast<std::uint32_t>(lane), cl};
+        return true;
+      }
+      if (sp + count > cap) {
+        stack_.resize(2 * cap + count);
+        st = stack_.data(), cap = stack_.size();
+      }
+      push_sorted(st, sp, mask, t, hd.first, cl);
+      it = st[--sp];
+      return true;
+    }
     if (sp + count > cap) {
       stack_.resize(2 * cap + count);
       st = stack_.data(), cap = stack_.size();
     }
-    // The hit children go straight onto the stack, insertion-sorted farthest first (the
-    // nearest is popped first). A later child (stored order) goes below the hits with equal
-    // t, so that among equals the first in stored order is popped first, as the recursion
-    // enters them (stable sort).
     const std::size_t base = sp;
-    auto collect = [&](unsigned mask, const float* t, int c0) {
-      for (; mask; mask &= mask - 1) {
-        const int lane = std::countr_zero(mask);
-        const float te = t[lane];  // never NaN: a NaN entry fails the kernel's t0 <= t1
-        std::size_t i = sp++;
-        while (i > base && st[i - 1].t <= te) st[i] = st[i - 1], --i;
-        st[i] = {te, hd.first + static_cast<std::uint32_t>(c0 + lane), cl};
-      }
-    };
-    const WideBox4* blk = w.blocks.data() + hd.block;
     int c0 = 0;
 #if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
     for (; count - c0 > kWideLanes; c0 += 2 * kWideLanes, blk += 2) {
       alignas(32) float t[2 * kWideLanes];
       const int m = std::min(count - c0, 2 * kWideLanes);
-      collect(intersect_wide8<kZeroAxes>(blk[0], blk[1], wr, s.ray.tmin, s.ray.tmax, m, t), t, c0);
+      push_sorted(st, sp,
+                  intersect_wide8<kZeroAxes>(blk[0], blk[1], wr, s.ray.tmin, s.ray.tmax, m, t), t,
+                  hd.first + static_cast<std::uint32_t>(c0), cl, base);
     }
 #endif
     for (; c0 < count; c0 += kWideLanes, ++blk) {
       alignas(16) float t[kWideLanes];
       const int m = std::min(count - c0, kWideLanes);
-      collect(intersect_wide4<kZeroAxes>(*blk, wr, s.ray.tmin, s.ray.tmax, m, t), t, c0);
+      push_sorted(st, sp, intersect_wide4<kZeroAxes>(*blk, wr, s.ray.tmin, s.ray.tmax, m, t), t,
+                  hd.first + static_cast<std::uint32_t>(c0), cl, base);
     }
+    if (sp == base) return false;
+    it = st[--sp];
+    return true;
+  }
+
+  /// Pushes the lanes of `mask` (children `first + lane`, entered at `t[lane]`) onto the stack
+  /// above `base`, insertion-sorted farthest first (the nearest is popped first). A later
+  /// child (stored order) goes below the hits with equal t, so that among equals the first in
+  /// stored order is popped first, as the recursion enters them (stable sort).
+  [[gnu::always_inline]] static void push_sorted(StackItem* st, std::size_t& sp, unsigned mask,
+                                                 const float* t, std::uint32_t first, int level,
+                                                 std::size_t base) {
+    for (; mask; mask &= mask - 1) {
+      const int lane = std::countr_zero(mask);
+      const float te = t[lane];  // never NaN: a NaN entry fails the kernel's t0 <= t1
+      std::size_t i = sp++;
+      while (i > base && st[i - 1].t <= te) st[i] = st[i - 1], --i;
+      st[i] = {te, first + static_cast<std::uint32_t>(lane), level};
+    }
+  }
+  [[gnu::always_inline]] static void push_sorted(StackItem* st, std::size_t& sp, unsigned mask,
+                                                 const float* t, std::uint32_t first, int level) {
+    push_sorted(st, sp, mask, t, first, level, sp);
   }
 
   /// A triangle-only leaf, four triangles at a time (`triangle_test4`), with the results and
