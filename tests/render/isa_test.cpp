@@ -71,17 +71,21 @@ TEST(Isa, Avx2CopyGivesThePortableBits) {
   std::vector<LoadedScene> scenes;
   scenes.push_back(load_scene("builtin:demo", Params("builtin:demo")));
   scenes.push_back(load_scene("builtin:line", Params("builtin:line")));
-  scenes.push_back(load_scene(wuson, Params(wuson)));  // explicit, 4-wide
+  // explicit, the default 8-wide nodes (intersect_wide8) and leaves of up to 8 triangles
+  // (the 8-lane triangle kernel over two packs)
+  scenes.push_back(load_scene(wuson, Params(wuson)));
   scenes.push_back(load_scene(std::string(AMALGAM_SOURCE_DIR) + "/scenes/wuson-grid.json",
                               Params("grid")));  // instanced
-  {
-    // 8-wide nodes: the AVX2 copy tests eight child boxes at once (intersect_wide8).
+  for (const int arity : {4, 13}) {
+    // 4-wide nodes and leaves (one SSE-width block, one pack); 13: several kernel calls per
+    // node (8 + 4 + 1 boxes) and per leaf (8 + 4 + 1 triangles).
     LoadedScene w = load_scene(wuson, Params(wuson));
     const auto& e = std::get<ExplicitHierarchy>(w.hierarchy);
     BuildConfig c;
-    c.arity = 8;
+    c.arity = arity;
+    c.leaf_size = arity;
     w.hierarchy = build_explicit(e.prims, e.materials, c);
-    w.name += " (arity 8)";
+    w.name += " (arity and leaves " + std::to_string(arity) + ")";
     scenes.push_back(std::move(w));
   }
   for (const LoadedScene& s : scenes)

@@ -26,6 +26,8 @@
 #include "amalgam/traverse/lod.h"
 #include "amalgam/traverse/reference.h"
 #include "amalgam/traverse/traverse.h"
+#include "amalgam/util/isa.h"
+#include "avx2_kernels.h"
 
 namespace amalgam {
 namespace {
@@ -269,6 +271,61 @@ TEST(SimdTraversal, TrianglePackKernelMatchesScalarTriangleTest) {
   EXPECT_GT(hits, 5000);
   EXPECT_GT(edge_hits, 500) << "rays through edges and vertices must be covered";
 }
+
+#if defined(AMALGAM_BUILD_AVX2_COPY)
+/// The AVX2 copy's 8-lane kernel (two packs at once, the leaves of 5..8 triangles) against the
+/// scalar test, on the cases above: same hit mask, bit-identical t, u, v, w, det per lane.
+TEST(SimdTraversal, EightLaneTriangleKernelMatchesScalarTriangleTest) {
+  if (!simd_avx2_supported()) GTEST_SKIP() << "this CPU has no AVX2";
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::uniform_int_distribution<int> grid(-2, 2);
+  int hits = 0, edge_hits = 0, high_lane_hits = 0;
+  for (int i = 0; i < 20000; ++i) {
+    Vec3 tri[2 * kWideLanes][3];
+    const TrianglePack4 packs[2] = {random_pack(rng, i, tri), random_pack(rng, i + 1, tri + 4)};
+    Vec3 o{u(rng), u(rng), u(rng)}, d{u(rng), u(rng), u(rng)};
+    if (i % 4 == 0) {
+      const int axis = i / 4 % 3;
+      o = {float(grid(rng)), float(grid(rng)), float(grid(rng))};
+      o[axis] = 3.0f;
+      d = {};
+      d[axis] = i % 8 == 0 ? -1.0f : 1.0f;
+    } else if (i % 4 == 1) {
+      const Vec3* t = tri[i / 4 % (2 * kWideLanes)];
+      o = o * 3.0f;
+      d = (i % 8 == 1 ? t[0] : (t[1] + t[2]) * 0.5f) - o;
+    } else if (i % 4 == 2) {
+      o = {float(grid(rng)), float(grid(rng)), 3.0f};
+      d = {0.5f * float(grid(rng)), 0.5f * float(grid(rng)), -1.0f};
+    }
+    const float tmin = i % 5 == 0 ? 0.5f : 0.0f, tmax = i % 7 == 0 ? 1.5f : kInfinity;
+    const Ray ray = Ray::make(o, d, tmin, tmax);
+    const TrianglePre pre = TrianglePre::of(ray);
+    const int n = 1 + i % (2 * kWideLanes);
+    float out[5][8];
+    const unsigned mask = test::avx2_triangle_test8(packs, ray, tmin, tmax, n, out);
+    ASSERT_EQ(mask >> n, 0u) << "case " << i << ": lanes beyond n";
+    for (int lane = 0; lane < n; ++lane) {
+      TriangleCandidate h;
+      const bool hit = triangle_test(ray, pre, tri[lane][0], tri[lane][1], tri[lane][2], h);
+      ASSERT_EQ(((mask >> lane) & 1u) != 0, hit) << "case " << i << " lane " << lane;
+      if (!hit) continue;
+      ++hits;
+      high_lane_hits += lane >= kWideLanes;
+      edge_hits += h.u == 0.0f || h.v == 0.0f || h.w == 0.0f;
+      EXPECT_EQ(bits(out[0][lane]), bits(h.t)) << "case " << i << " lane " << lane;
+      EXPECT_EQ(bits(out[1][lane]), bits(h.u)) << "case " << i << " lane " << lane;
+      EXPECT_EQ(bits(out[2][lane]), bits(h.v)) << "case " << i << " lane " << lane;
+      EXPECT_EQ(bits(out[3][lane]), bits(h.w)) << "case " << i << " lane " << lane;
+      EXPECT_EQ(bits(out[4][lane]), bits(h.det)) << "case " << i << " lane " << lane;
+    }
+  }
+  EXPECT_GT(hits, 2500);
+  EXPECT_GT(high_lane_hits, 1000) << "the second pack's lanes must be covered";
+  EXPECT_GT(edge_hits, 250) << "rays through edges and vertices must be covered";
+}
+#endif
 
 /// Triangle-only leaves of several packs (leaf sizes 5..9), duplicated triangles (ties in t
 /// inside a leaf and across its packs) and rays along lattice lines through shared edges and

@@ -36,6 +36,7 @@ struct WideRay {
   __m128 ok4[3];     ///< o[pre.kx], o[pre.ky], o[pre.kz]
 #if defined(AMALGAM_ISA_AVX2)
   __m256 o8[3], inv8[3];
+  __m256 shear8[3], ok8[3];  ///< as shear4, ok4, for the 8-wide triangle test
 #endif
 #endif
   static WideRay of(const Ray& r) {
@@ -55,6 +56,11 @@ struct WideRay {
     w.shear4[0] = _mm_set1_ps(w.pre.sx), w.shear4[1] = _mm_set1_ps(w.pre.sy);
     w.shear4[2] = _mm_set1_ps(w.pre.sz);
     w.ok4[0] = w.o4[w.pre.kx], w.ok4[1] = w.o4[w.pre.ky], w.ok4[2] = w.o4[w.pre.kz];
+#if defined(AMALGAM_ISA_AVX2)
+    w.shear8[0] = _mm256_set1_ps(w.pre.sx), w.shear8[1] = _mm256_set1_ps(w.pre.sy);
+    w.shear8[2] = _mm256_set1_ps(w.pre.sz);
+    w.ok8[0] = w.o8[w.pre.kx], w.ok8[1] = w.o8[w.pre.ky], w.ok8[2] = w.o8[w.pre.kz];
+#endif
 #endif
     return w;
   }
@@ -153,83 +159,141 @@ inline unsigned intersect_wide8(const WideBox4& b0, const WideBox4& b1, const Wi
 }
 #endif
 
-/// A pack test's candidates by lane (valid where its hit mask is set).
-struct alignas(16) TrianglePackHits {
-  float t[kWideLanes], u[kWideLanes], v[kWideLanes], w[kWideLanes], det[kWideLanes];
+/// A pack test's candidates by lane (valid where its hit mask is set); N = 4, or 8 for two
+/// packs tested at once (AVX2).
+template <int N>
+struct alignas(32) TrianglePackHitsN {
+  float t[N], u[N], v[N], w[N], det[N];
   TriangleCandidate lane(int i) const { return {t[i], u[i], v[i], w[i], det[i]}; }
 };
+using TrianglePackHits = TrianglePackHitsN<kWideLanes>;
 
-/// `triangle_test` on the first `n` (1..4) triangles of `p` at once, each against the same
-/// [tmin, tmax]: the hit lanes as a bit mask, their t and barycentrics in `out`, lane for lane
-/// bit-identical to the scalar test. The SSE form performs the scalar test's float operations
-/// in the same order on the same operands (a product is commutative in IEEE arithmetic, a sum
-/// of three is not: both sum left to right), with no fused multiply-add (the build does not
-/// enable FMA), and takes the same double-precision path for a lane whose u, v or w is zero.
-/// The caller picks the closest hit among the lanes (a lane's tmax does not shrink by an
-/// earlier lane's hit here, unlike in a one-by-one loop).
-inline unsigned triangle_test4(const TrianglePack4& p, const WideRay& r, float tmin, float tmax,
-                               int n, TrianglePackHits& out) {
+#if AMALGAM_WIDE_SSE
+/// The vector operations the triangle kernel needs, 4 lanes (SSE) from one pack...
+struct TriangleLanes4 {
+  using V = __m128;
+  static constexpr int kLanes = 4;
+  static V load(const TrianglePack4* p, int vertex, int axis) {
+    return _mm_load_ps(p[0].v[vertex][axis]);
+  }
+  static V set1(float x) { return _mm_set1_ps(x); }
+  static V zero() { return _mm_setzero_ps(); }
+  static V add(V a, V b) { return _mm_add_ps(a, b); }
+  static V sub(V a, V b) { return _mm_sub_ps(a, b); }
+  static V mul(V a, V b) { return _mm_mul_ps(a, b); }
+  static V div(V a, V b) { return _mm_div_ps(a, b); }
+  static V eq(V a, V b) { return _mm_cmpeq_ps(a, b); }
+  static V lt(V a, V b) { return _mm_cmplt_ps(a, b); }
+  static V gt(V a, V b) { return _mm_cmpgt_ps(a, b); }
+  static V ge(V a, V b) { return _mm_cmpge_ps(a, b); }
+  static V le(V a, V b) { return _mm_cmple_ps(a, b); }
+  static V bor(V a, V b) { return _mm_or_ps(a, b); }
+  static V band(V a, V b) { return _mm_and_ps(a, b); }
+  static V andnot(V a, V b) { return _mm_andnot_ps(a, b); }
+  static unsigned mask(V a) { return static_cast<unsigned>(_mm_movemask_ps(a)); }
+  static void store(float* d, V a) { _mm_store_ps(d, a); }
+  static V load_aligned(const float* d) { return _mm_load_ps(d); }
+  static const V* shear(const WideRay& r) { return r.shear4; }
+  static const V* origin(const WideRay& r) { return r.ok4; }
+};
+#if defined(AMALGAM_ISA_AVX2)
+/// ... or 8 lanes (AVX) from two consecutive packs. Without FMA (the build does not enable
+/// it), each lane performs exactly the SSE form's operations.
+struct TriangleLanes8 {
+  using V = __m256;
+  static constexpr int kLanes = 8;
+  static V load(const TrianglePack4* p, int vertex, int axis) {
+    return _mm256_set_m128(_mm_load_ps(p[1].v[vertex][axis]), _mm_load_ps(p[0].v[vertex][axis]));
+  }
+  static V set1(float x) { return _mm256_set1_ps(x); }
+  static V zero() { return _mm256_setzero_ps(); }
+  static V add(V a, V b) { return _mm256_add_ps(a, b); }
+  static V sub(V a, V b) { return _mm256_sub_ps(a, b); }
+  static V mul(V a, V b) { return _mm256_mul_ps(a, b); }
+  static V div(V a, V b) { return _mm256_div_ps(a, b); }
+  static V eq(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_EQ_OQ); }
+  static V lt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LT_OQ); }
+  static V gt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GT_OQ); }
+  static V ge(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GE_OQ); }
+  static V le(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LE_OQ); }
+  static V bor(V a, V b) { return _mm256_or_ps(a, b); }
+  static V band(V a, V b) { return _mm256_and_ps(a, b); }
+  static V andnot(V a, V b) { return _mm256_andnot_ps(a, b); }
+  static unsigned mask(V a) { return static_cast<unsigned>(_mm256_movemask_ps(a)); }
+  static void store(float* d, V a) { _mm256_store_ps(d, a); }
+  static V load_aligned(const float* d) { return _mm256_load_ps(d); }
+  static const V* shear(const WideRay& r) { return r.shear8; }
+  static const V* origin(const WideRay& r) { return r.ok8; }
+};
+#endif
+
+/// `triangle_test` on the first `n` (1..L::kLanes) triangles of the packs at `p` at once, each
+/// against the same [tmin, tmax]: the hit lanes as a bit mask, their t and barycentrics in
+/// `out`, lane for lane bit-identical to the scalar test. It performs the scalar test's float
+/// operations in the same order on the same operands (a product is commutative in IEEE
+/// arithmetic, a sum of three is not: both sum left to right), with no fused multiply-add, and
+/// takes the same double-precision path for a lane whose u, v or w is zero. The caller picks
+/// the closest hit among the lanes (a lane's tmax does not shrink by an earlier lane's hit
+/// here, unlike in a one-by-one loop).
+template <class L>
+inline unsigned triangle_test_lanes(const TrianglePack4* p, const WideRay& r, float tmin,
+                                    float tmax, int n, TrianglePackHitsN<L::kLanes>& out) {
+  using V = typename L::V;
+  constexpr int N = L::kLanes;
   const TrianglePre& pre = r.pre;
   const unsigned lanes = (1u << n) - 1u;
-#if AMALGAM_WIDE_SSE
   const int kx = pre.kx, ky = pre.ky, kz = pre.kz;
-  const __m128 sx = r.shear4[0], sy = r.shear4[1], sz = r.shear4[2];
-  const __m128 ox = r.ok4[0], oy = r.ok4[1], oz = r.ok4[2];
+  const V* shear = L::shear(r);
+  const V* org = L::origin(r);
+  const V sx = shear[0], sy = shear[1], sz = shear[2];
+  const V ox = org[0], oy = org[1], oz = org[2];
   // Sheared and translated vertices (scalar: A[kx] - sx * A[kz] with A = a - origin).
-  __m128 X[3], Y[3], Z[3];
+  V X[3], Y[3], Z[3];
   for (int k = 0; k < 3; ++k) {
-    Z[k] = _mm_sub_ps(_mm_load_ps(p.v[k][kz]), oz);
-    X[k] = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(p.v[k][kx]), ox), _mm_mul_ps(sx, Z[k]));
-    Y[k] = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(p.v[k][ky]), oy), _mm_mul_ps(sy, Z[k]));
+    Z[k] = L::sub(L::load(p, k, kz), oz);
+    X[k] = L::sub(L::sub(L::load(p, k, kx), ox), L::mul(sx, Z[k]));
+    Y[k] = L::sub(L::sub(L::load(p, k, ky), oy), L::mul(sy, Z[k]));
   }
-  __m128 u = _mm_sub_ps(_mm_mul_ps(X[2], Y[1]), _mm_mul_ps(Y[2], X[1]));  // cx by - cy bx
-  __m128 v = _mm_sub_ps(_mm_mul_ps(X[0], Y[2]), _mm_mul_ps(Y[0], X[2]));  // ax cy - ay cx
-  __m128 w = _mm_sub_ps(_mm_mul_ps(X[1], Y[0]), _mm_mul_ps(Y[1], X[0]));  // bx ay - by ax
-  const __m128 zero = _mm_setzero_ps();
+  V u = L::sub(L::mul(X[2], Y[1]), L::mul(Y[2], X[1]));  // cx by - cy bx
+  V v = L::sub(L::mul(X[0], Y[2]), L::mul(Y[0], X[2]));  // ax cy - ay cx
+  V w = L::sub(L::mul(X[1], Y[0]), L::mul(Y[1], X[0]));  // bx ay - by ax
+  const V zero = L::zero();
   const unsigned edge =
-      static_cast<unsigned>(_mm_movemask_ps(_mm_or_ps(
-          _mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)), _mm_cmpeq_ps(w, zero)))) &
-      lanes;
+      L::mask(L::bor(L::bor(L::eq(u, zero), L::eq(v, zero)), L::eq(w, zero))) & lanes;
   if (edge) [[unlikely]] {  // the scalar test's edge case, lane by lane in double precision
-    alignas(16) float x[3][kWideLanes], y[3][kWideLanes], U[kWideLanes], V[kWideLanes],
-        W[kWideLanes];
-    for (int k = 0; k < 3; ++k) _mm_store_ps(x[k], X[k]), _mm_store_ps(y[k], Y[k]);
-    _mm_store_ps(U, u), _mm_store_ps(V, v), _mm_store_ps(W, w);
+    alignas(32) float x[3][N], y[3][N], U[N], V_[N], W[N];
+    for (int k = 0; k < 3; ++k) L::store(x[k], X[k]), L::store(y[k], Y[k]);
+    L::store(U, u), L::store(V_, v), L::store(W, w);
     for (unsigned m = edge; m; m &= m - 1) {
       const int i = std::countr_zero(m);
       U[i] = static_cast<float>(double(x[2][i]) * y[1][i] - double(y[2][i]) * x[1][i]);
-      V[i] = static_cast<float>(double(x[0][i]) * y[2][i] - double(y[0][i]) * x[2][i]);
+      V_[i] = static_cast<float>(double(x[0][i]) * y[2][i] - double(y[0][i]) * x[2][i]);
       W[i] = static_cast<float>(double(x[1][i]) * y[0][i] - double(y[1][i]) * x[0][i]);
     }
-    u = _mm_load_ps(U), v = _mm_load_ps(V), w = _mm_load_ps(W);
+    u = L::load_aligned(U), v = L::load_aligned(V_), w = L::load_aligned(W);
   }
   // Reject mixed signs: (u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0).
-  const __m128 neg =
-      _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
-  const __m128 pos =
-      _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
-  const __m128 mixed = _mm_and_ps(neg, pos);
+  const V neg = L::bor(L::bor(L::lt(u, zero), L::lt(v, zero)), L::lt(w, zero));
+  const V pos = L::bor(L::bor(L::gt(u, zero), L::gt(v, zero)), L::gt(w, zero));
+  const V mixed = L::band(neg, pos);
   // Most packs stop here: every lane's ray passes outside its triangle.
-  if ((static_cast<unsigned>(_mm_movemask_ps(mixed)) & lanes) == lanes) return 0;
-  const __m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
-  const __m128 bad = _mm_or_ps(mixed, _mm_cmpeq_ps(det, zero));
+  if ((L::mask(mixed) & lanes) == lanes) return 0;
+  const V det = L::add(L::add(u, v), w);
+  const V bad = L::bor(mixed, L::eq(det, zero));
   // t = (u az + v bz + w cz) / det with az = sz A[kz].
-  const __m128 zs[3] = {_mm_mul_ps(sz, Z[0]), _mm_mul_ps(sz, Z[1]), _mm_mul_ps(sz, Z[2])};
-  const __m128 num =
-      _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, zs[0]), _mm_mul_ps(v, zs[1])), _mm_mul_ps(w, zs[2]));
-  const __m128 t = _mm_div_ps(num, det);
+  const V zs[3] = {L::mul(sz, Z[0]), L::mul(sz, Z[1]), L::mul(sz, Z[2])};
+  const V num = L::add(L::add(L::mul(u, zs[0]), L::mul(v, zs[1])), L::mul(w, zs[2]));
+  const V t = L::div(num, det);
   // !(t >= tmin && t <= tmax) rejects: ordered compares, so a NaN t is rejected as well.
-  const __m128 in =
-      _mm_and_ps(_mm_cmpge_ps(t, _mm_set1_ps(tmin)), _mm_cmple_ps(t, _mm_set1_ps(tmax)));
-  _mm_store_ps(out.t, t), _mm_store_ps(out.u, u), _mm_store_ps(out.v, v);
-  _mm_store_ps(out.w, w), _mm_store_ps(out.det, det);
-  unsigned hits = static_cast<unsigned>(_mm_movemask_ps(_mm_andnot_ps(bad, in))) & lanes;
+  const V in = L::band(L::ge(t, L::set1(tmin)), L::le(t, L::set1(tmax)));
+  L::store(out.t, t), L::store(out.u, u), L::store(out.v, v);
+  L::store(out.w, w), L::store(out.det, det);
+  unsigned hits = L::mask(L::andnot(bad, in)) & lanes;
   if (hits) {
     // The scalar test's rejection of t within its rounding error, lane by lane on the same
     // operands (triangle_t_error).
-    alignas(16) float x[3][kWideLanes], y[3][kWideLanes], z[3][kWideLanes];
-    for (int k = 0; k < 3; ++k)
-      _mm_store_ps(x[k], X[k]), _mm_store_ps(y[k], Y[k]), _mm_store_ps(z[k], Z[k]);
+    alignas(32) float x[3][N], y[3][N], z[3][N];
+    for (int k = 0; k < 3; ++k) L::store(x[k], X[k]), L::store(y[k], Y[k]), L::store(z[k], Z[k]);
     for (unsigned m = hits; m; m &= m - 1) {
       const int i = std::countr_zero(m);
       if (out.t[i] <= triangle_t_error(x[0][i], y[0][i], x[1][i], y[1][i], x[2][i], y[2][i],
@@ -239,7 +303,17 @@ inline unsigned triangle_test4(const TrianglePack4& p, const WideRay& r, float t
     }
   }
   return hits;
+}
+#endif
+
+/// `triangle_test` on the first `n` (1..4) triangles of `p` at once (SSE, `triangle_test_lanes`;
+/// a scalar loop without SSE).
+inline unsigned triangle_test4(const TrianglePack4& p, const WideRay& r, float tmin, float tmax,
+                               int n, TrianglePackHits& out) {
+#if AMALGAM_WIDE_SSE
+  return triangle_test_lanes<TriangleLanes4>(&p, r, tmin, tmax, n, out);
 #else
+  const TrianglePre& pre = r.pre;
   Ray ray;
   ray.origin = {r.o[0], r.o[1], r.o[2]};
   ray.tmin = tmin, ray.tmax = tmax;
@@ -253,7 +327,6 @@ inline unsigned triangle_test4(const TrianglePack4& p, const WideRay& r, float t
     mask |= 1u << i;
     out.t[i] = h.t, out.u[i] = h.u, out.v[i] = h.v, out.w[i] = h.w, out.det[i] = h.det;
   }
-  (void)lanes;
   return mask;
 #endif
 }

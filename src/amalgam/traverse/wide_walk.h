@@ -198,33 +198,53 @@ class WideWalk {
     push_sorted(st, sp, mask, t, first, level, sp);
   }
 
-  /// A triangle-only leaf, four triangles at a time (`triangle_test4`), with the results and
-  /// counts of the one-by-one loop: there, a triangle is tested against the tmax left by the
-  /// hits before it, so of the lanes hit (all tested against the same tmax) a lane is taken in
-  /// leaf order when its t is still <= tmax (ties: the later one, as there); a shadow ray stops
-  /// at the first hit in leaf order, having tested the triangles up to and including it.
+  /// A triangle-only leaf, four triangles at a time (`triangle_test4`; eight, from two packs,
+  /// in the AVX2 copy), with the results and counts of the one-by-one loop: there, a triangle
+  /// is tested against the tmax left by the hits before it, so of the lanes hit (all tested
+  /// against the same tmax) a lane is taken in leaf order when its t is still <= tmax (ties:
+  /// the later one, as there); a shadow ray stops at the first hit in leaf order, having tested
+  /// the triangles up to and including it.
   static void leaf_triangles(State& s, const WideNodes& w, const WideRay& wr, const WideHeader& hd,
                              int level) {
     const TrianglePack4* pack = w.tris.data() + hd.block;
     const int count = hd.count;
-    for (int c0 = 0; c0 < count; c0 += kWideLanes, ++pack) {
-      const int m = std::min(count - c0, kWideLanes);
-      TrianglePackHits c;
-      unsigned mask = triangle_test4(*pack, wr, s.ray.tmin, s.ray.tmax, m, c);
-      if (s.any_hit && mask) {
-        const int tested = std::countr_zero(mask) + 1;
-        for (int i = 0; i < tested; ++i)
-          s.counters.count_test(s.kind, ObjectKind::kPrimitive, level);
-        s.occlude();
+    int c0 = 0;
+#if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
+    for (; count - c0 > kWideLanes; c0 += 2 * kWideLanes, pack += 2) {
+      TrianglePackHitsN<2 * kWideLanes> c;
+      const int m = std::min(count - c0, 2 * kWideLanes);
+      if (!take(s, hd, level, c0, m,
+                triangle_test_lanes<TriangleLanes8>(pack, wr, s.ray.tmin, s.ray.tmax, m, c), c))
         return;
-      }
-      for (int i = 0; i < m; ++i) s.counters.count_test(s.kind, ObjectKind::kPrimitive, level);
-      for (; mask; mask &= mask - 1) {
-        const int lane = std::countr_zero(mask);
-        if (!(c.t[lane] <= s.ray.tmax)) continue;  // an earlier lane hit closer
-        s.on_triangle(hd.first + static_cast<std::uint32_t>(c0 + lane), level, c.lane(lane));
-      }
     }
+#endif
+    for (; c0 < count; c0 += kWideLanes, ++pack) {
+      TrianglePackHits c;
+      const int m = std::min(count - c0, kWideLanes);
+      if (!take(s, hd, level, c0, m, triangle_test4(*pack, wr, s.ray.tmin, s.ray.tmax, m, c), c))
+        return;
+    }
+  }
+
+  /// The lanes `mask` of a pack test of `m` triangles from `c0` of the leaf: counts them and
+  /// takes the hits as the one-by-one loop would. False when the ray is done (a shadow ray
+  /// occluded).
+  template <class Hits>
+  [[gnu::always_inline]] static bool take(State& s, const WideHeader& hd, int level, int c0, int m,
+                                          unsigned mask, const Hits& c) {
+    if (s.any_hit && mask) {
+      const int tested = std::countr_zero(mask) + 1;
+      for (int i = 0; i < tested; ++i) s.counters.count_test(s.kind, ObjectKind::kPrimitive, level);
+      s.occlude();
+      return false;
+    }
+    for (int i = 0; i < m; ++i) s.counters.count_test(s.kind, ObjectKind::kPrimitive, level);
+    for (; mask; mask &= mask - 1) {
+      const int lane = std::countr_zero(mask);
+      if (!(c.t[lane] <= s.ray.tmax)) continue;  // an earlier lane hit closer
+      s.on_triangle(hd.first + static_cast<std::uint32_t>(c0 + lane), level, c.lane(lane));
+    }
+    return true;
   }
 
   /// One primitive of a mixed leaf: triangles with the per-ray setup and a deferred

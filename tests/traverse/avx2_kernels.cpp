@@ -1,0 +1,33 @@
+// The AVX2 copy's triangle kernel for simd_test.cpp, compiled as render/render_avx2.cpp
+// compiles the library's AVX2 copy: the lower layers first, for the baseline, then the hot-path
+// header under GCC's target pragma, in the inline namespace isa_avx2.
+#include "avx2_kernels.h"
+
+#if defined(AMALGAM_BUILD_AVX2_COPY)
+#define AMALGAM_ISA_AVX2 1  // before any include: util/isa.h reads it once
+
+#include <bit>
+
+#include "amalgam/geometry/intersect.h"
+#include "amalgam/geometry/wide.h"
+
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#include "amalgam/geometry/wide_kernels.h"
+
+namespace amalgam::test {
+
+unsigned avx2_triangle_test8(const TrianglePack4 p[2], const Ray& ray, float tmin, float tmax,
+                             int n, float out[5][8]) {
+  TrianglePackHitsN<8> h;
+  const unsigned mask = triangle_test_lanes<TriangleLanes8>(p, WideRay::of(ray), tmin, tmax, n, h);
+  for (int i = 0; i < 8; ++i)
+    out[0][i] = h.t[i], out[1][i] = h.u[i], out[2][i] = h.v[i], out[3][i] = h.w[i],
+    out[4][i] = h.det[i];
+  return mask;
+}
+
+}  // namespace amalgam::test
+#pragma GCC pop_options
+
+#endif

@@ -1,0 +1,16 @@
+#pragma once
+// The AVX2 copy's 8-lane triangle kernel, compiled for AVX2 in avx2_kernels.cpp, for the
+// differential test in simd_test.cpp (the rest of the tests run the portable copy). Defined
+// only where the library has its AVX2 copy (AMALGAM_BUILD_AVX2_COPY).
+
+#include "amalgam/geometry/ray.h"
+#include "amalgam/geometry/wide.h"
+
+namespace amalgam::test {
+
+/// `triangle_test_lanes<TriangleLanes8>` on the packs p[0], p[1] (first `n` lanes, 1..8): the
+/// hit mask; out[0..4][lane] = t, u, v, w, det of each hit lane.
+unsigned avx2_triangle_test8(const TrianglePack4 p[2], const Ray& ray, float tmin, float tmax,
+                             int n, float out[5][8]);
+
+}  // namespace amalgam::test
