@@ -66,46 +66,112 @@ struct WideRay {
   }
 };
 
-/// Tests the first `n` (1..4) boxes of `b` against the ray over [tmin, tmax], exactly as
-/// `intersect_box` would one at a time. Returns the lanes hit as a bit mask; `t_entry[i]` is
-/// the entry parameter (Span::t0) of lane i where it is hit. `kZeroAxes` false: the caller
-/// knows that `r` has no zero direction component (`!r.any_zero`), so the per-axis branch of
-/// that case is left out.
+/// How the box kernel may treat a ray's axes: kZeroAxes, a direction component may be zero
+/// (that axis is a containment test, as in intersect_box); kNonZero, none is (`!r.any_zero`),
+/// so the per-axis branch of that case is left out.
+enum class BoxRays { kZeroAxes, kNonZero };
+
+#if AMALGAM_WIDE_SSE
+/// The vector operations of the box kernel, 4 lanes (SSE) from one block...
+struct BoxLanes4 {
+  using V = __m128;
+  static constexpr int kLanes = 4;
+  static V load(const WideBox4* b, std::uint32_t byte_offset) {
+    return _mm_load_ps(
+        reinterpret_cast<const float*>(reinterpret_cast<const char*>(b) + byte_offset));
+  }
+  static V set1(float x) { return _mm_set1_ps(x); }
+  static V all() { return _mm_castsi128_ps(_mm_set1_epi32(-1)); }
+  static V sub(V a, V b) { return _mm_sub_ps(a, b); }
+  static V mul(V a, V b) { return _mm_mul_ps(a, b); }
+  static V min(V a, V b) { return _mm_min_ps(a, b); }
+  static V max(V a, V b) { return _mm_max_ps(a, b); }
+  static V le(V a, V b) { return _mm_cmple_ps(a, b); }
+  static V nlt(V a, V b) { return _mm_cmpnlt_ps(a, b); }
+  static V ngt(V a, V b) { return _mm_cmpngt_ps(a, b); }
+  static V band(V a, V b) { return _mm_and_ps(a, b); }
+  static unsigned mask(V a) { return static_cast<unsigned>(_mm_movemask_ps(a)); }
+  static void store(float* d, V a) { _mm_storeu_ps(d, a); }
+  static const V* origin(const WideRay& r) { return r.o4; }
+  static const V* inv(const WideRay& r) { return r.inv4; }
+};
+#if defined(AMALGAM_ISA_AVX2)
+/// ... or 8 lanes (AVX) from two consecutive blocks.
+struct BoxLanes8 {
+  using V = __m256;
+  static constexpr int kLanes = 8;
+  static V load(const WideBox4* b, std::uint32_t byte_offset) {
+    return _mm256_set_m128(BoxLanes4::load(b + 1, byte_offset), BoxLanes4::load(b, byte_offset));
+  }
+  static V set1(float x) { return _mm256_set1_ps(x); }
+  static V all() { return _mm256_castsi256_ps(_mm256_set1_epi32(-1)); }
+  static V sub(V a, V b) { return _mm256_sub_ps(a, b); }
+  static V mul(V a, V b) { return _mm256_mul_ps(a, b); }
+  static V min(V a, V b) { return _mm256_min_ps(a, b); }
+  static V max(V a, V b) { return _mm256_max_ps(a, b); }
+  static V le(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LE_OQ); }
+  static V nlt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_NLT_US); }
+  static V ngt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_NGT_US); }
+  static V band(V a, V b) { return _mm256_and_ps(a, b); }
+  static unsigned mask(V a) { return static_cast<unsigned>(_mm256_movemask_ps(a)); }
+  static void store(float* d, V a) { _mm256_storeu_ps(d, a); }
+  static const V* origin(const WideRay& r) { return r.o8; }
+  static const V* inv(const WideRay& r) { return r.inv8; }
+};
+#endif
+
+/// Tests the first `n` (1..L::kLanes) boxes of the blocks at `b` against the ray over [tmin,
+/// tmax], exactly as `intersect_box` would one at a time. Returns the lanes hit as a bit mask;
+/// `t_entry[i]` is the entry parameter (Span::t0) of lane i where it is hit.
 ///
 /// The enlargement of the far distance by 2 gamma(3) (the scalar test's `t1 *= ...` per axis)
 /// is applied once to the minimum over the axes instead of to each axis: x -> x * (1 + 2
 /// gamma(3)) rounded is non-decreasing and maps only zeros to zero, so the minimum of the
 /// products and the product of the minimum are the same float (a NaN is skipped either way).
+template <class L, BoxRays kRays>
+inline unsigned box_test_lanes(const WideBox4* b, const WideRay& r, float tmin, float tmax, int n,
+                               float* t_entry) {
+  using V = typename L::V;
+  constexpr float kGrow = 1.0f + 2.0f * gamma(3);
+  constexpr std::uint32_t kLo = 0, kHi = 3 * kWideLanes * sizeof(float);
+  V t_near = L::set1(-kInfinity), t_far = L::set1(kInfinity);
+  V ok = L::all();
+  for (int a = 0; a < 3; ++a) {
+    const V o = L::origin(r)[a];
+    const std::uint32_t axis = static_cast<std::uint32_t>(a * kWideLanes * sizeof(float));
+    const V lo = L::load(b, kLo + axis), hi = L::load(b, kHi + axis);
+    if (kRays == BoxRays::kZeroAxes && r.zero[a]) {  // scalar: if (o < lo || o > hi) miss
+      ok = L::band(ok, L::band(L::nlt(o, lo), L::ngt(o, hi)));
+      continue;
+    }
+    const V inv = L::inv(r)[a];
+    const V t0 = L::mul(L::sub(lo, o), inv);
+    const V t1 = L::mul(L::sub(hi, o), inv);
+    // scalar: if (t0 > t1) swap. minps(x, y) = x < y ? x : y; maxps(x, y) = x > y ? x : y.
+    const V tn = L::min(t1, t0);
+    const V tf = L::max(t0, t1);
+    t_near = L::max(tn, t_near);  // if (t0 > t_near) t_near = t0
+    t_far = L::min(tf, t_far);    // if (t1 < t_far) t_far = t1
+  }
+  t_far = L::mul(t_far, L::set1(kGrow));
+  ok = L::band(ok, L::le(t_near, t_far));
+  const V s0 = L::max(L::set1(tmin), t_near);  // std::max(t_near, tmin)
+  const V s1 = L::min(L::set1(tmax), t_far);   // std::min(t_far, tmax)
+  ok = L::band(ok, L::le(s0, s1));
+  L::store(t_entry, s0);
+  return L::mask(ok) & ((1u << n) - 1u);
+}
+#endif
+
+/// `box_test_lanes` on the first `n` (1..4) boxes of `b` (SSE; a scalar loop without SSE,
+/// where every mode is the scalar test). `kZeroAxes` false: the caller knows that `r` has no
+/// zero direction component (`!r.any_zero`), so the per-axis branch of that case is left out.
 template <bool kZeroAxes = true>
 inline unsigned intersect_wide4(const WideBox4& b, const WideRay& r, float tmin, float tmax, int n,
                                 float t_entry[kWideLanes]) {
-  constexpr float kGrow = 1.0f + 2.0f * gamma(3);
 #if AMALGAM_WIDE_SSE
-  __m128 t_near = _mm_set1_ps(-kInfinity), t_far = _mm_set1_ps(kInfinity);
-  __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
-  for (int a = 0; a < 3; ++a) {
-    const __m128 o = r.o4[a];
-    const __m128 lo = _mm_load_ps(b.lo[a]), hi = _mm_load_ps(b.hi[a]);
-    if (kZeroAxes && r.zero[a]) {  // scalar: if (o < lo || o > hi) miss
-      ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpnlt_ps(o, lo), _mm_cmpngt_ps(o, hi)));
-      continue;
-    }
-    const __m128 inv = r.inv4[a];
-    const __m128 t0 = _mm_mul_ps(_mm_sub_ps(lo, o), inv);
-    const __m128 t1 = _mm_mul_ps(_mm_sub_ps(hi, o), inv);
-    // scalar: if (t0 > t1) swap. minps(x, y) = x < y ? x : y; maxps(x, y) = x > y ? x : y.
-    const __m128 tn = _mm_min_ps(t1, t0);
-    const __m128 tf = _mm_max_ps(t0, t1);
-    t_near = _mm_max_ps(tn, t_near);  // if (t0 > t_near) t_near = t0
-    t_far = _mm_min_ps(tf, t_far);    // if (t1 < t_far) t_far = t1
-  }
-  t_far = _mm_mul_ps(t_far, _mm_set1_ps(kGrow));
-  ok = _mm_and_ps(ok, _mm_cmple_ps(t_near, t_far));
-  const __m128 s0 = _mm_max_ps(_mm_set1_ps(tmin), t_near);  // std::max(t_near, tmin)
-  const __m128 s1 = _mm_min_ps(_mm_set1_ps(tmax), t_far);   // std::min(t_far, tmax)
-  ok = _mm_and_ps(ok, _mm_cmple_ps(s0, s1));
-  _mm_storeu_ps(t_entry, s0);
-  return static_cast<unsigned>(_mm_movemask_ps(ok)) & ((1u << n) - 1u);
+  return box_test_lanes < BoxLanes4,
+         kZeroAxes ? BoxRays::kZeroAxes : BoxRays::kNonZero > (&b, r, tmin, tmax, n, t_entry);
 #else
   unsigned mask = 0;
   for (int i = 0; i < n; ++i) {
@@ -118,46 +184,9 @@ inline unsigned intersect_wide4(const WideBox4& b, const WideRay& r, float tmin,
     float t0, t1;
     if (intersect_box(ray, box, t0, t1)) mask |= 1u << i, t_entry[i] = t0;
   }
-  (void)kGrow;
   return mask;
 #endif
 }
-
-#if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
-/// Two blocks (8 boxes, the first `n` of them used, 5..8) at once with AVX; same contract as
-/// `intersect_wide4`.
-template <bool kZeroAxes = true>
-inline unsigned intersect_wide8(const WideBox4& b0, const WideBox4& b1, const WideRay& r,
-                                float tmin, float tmax, int n, float t_entry[2 * kWideLanes]) {
-  constexpr float kGrow = 1.0f + 2.0f * gamma(3);
-  __m256 t_near = _mm256_set1_ps(-kInfinity), t_far = _mm256_set1_ps(kInfinity);
-  __m256 ok = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
-  for (int a = 0; a < 3; ++a) {
-    const __m256 o = r.o8[a];
-    const __m256 lo = _mm256_set_m128(_mm_load_ps(b1.lo[a]), _mm_load_ps(b0.lo[a]));
-    const __m256 hi = _mm256_set_m128(_mm_load_ps(b1.hi[a]), _mm_load_ps(b0.hi[a]));
-    if (kZeroAxes && r.zero[a]) {
-      ok = _mm256_and_ps(
-          ok, _mm256_and_ps(_mm256_cmp_ps(o, lo, _CMP_NLT_US), _mm256_cmp_ps(o, hi, _CMP_NGT_US)));
-      continue;
-    }
-    const __m256 inv = r.inv8[a];
-    const __m256 t0 = _mm256_mul_ps(_mm256_sub_ps(lo, o), inv);
-    const __m256 t1 = _mm256_mul_ps(_mm256_sub_ps(hi, o), inv);
-    const __m256 tn = _mm256_min_ps(t1, t0);
-    const __m256 tf = _mm256_max_ps(t0, t1);
-    t_near = _mm256_max_ps(tn, t_near);
-    t_far = _mm256_min_ps(tf, t_far);
-  }
-  t_far = _mm256_mul_ps(t_far, _mm256_set1_ps(kGrow));
-  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t_near, t_far, _CMP_LE_OQ));
-  const __m256 s0 = _mm256_max_ps(_mm256_set1_ps(tmin), t_near);
-  const __m256 s1 = _mm256_min_ps(_mm256_set1_ps(tmax), t_far);
-  ok = _mm256_and_ps(ok, _mm256_cmp_ps(s0, s1, _CMP_LE_OQ));
-  _mm256_storeu_ps(t_entry, s0);
-  return static_cast<unsigned>(_mm256_movemask_ps(ok)) & ((1u << n) - 1u);
-}
-#endif
 
 /// A pack test's candidates by lane (valid where its hit mask is set); N = 4, or 8 for two
 /// packs tested at once (AVX2).

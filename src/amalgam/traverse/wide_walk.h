@@ -40,9 +40,9 @@ class WideWalk {
     // A ray with a zero direction component needs the box test's containment branch per
     // axis; all others (nearly every ray) run a loop without those branches.
     if (s.ray.dir.x == 0.0f || s.ray.dir.y == 0.0f || s.ray.dir.z == 0.0f)
-      loop<true>(s, w);
+      loop<BoxRays::kZeroAxes>(s, w);
     else
-      loop<false>(s, w);
+      loop<BoxRays::kNonZero>(s, w);
   }
 
   /// Builds the SurfaceHit of the closest hit when it is a deferred triangle.
@@ -67,7 +67,7 @@ class WideWalk {
   /// checked, and nothing between its test and its entry changes tmax or `done`), so a node
   /// with one hit child costs no stack traffic. The stack is `stack_[0, sp)`, grown before a
   /// node's children are pushed.
-  template <bool kZeroAxes>
+  template <BoxRays kRays>
   void loop(State& s, const WideNodes& w) {
     // The per-ray constants and the stack's base and capacity as locals: members would be
     // reloaded after every store to the stack (a float store may alias them).
@@ -88,36 +88,45 @@ class WideWalk {
           }
         }
       }
-      if (!rendered && expand<kZeroAxes>(s, w, wr, it, st, cap, sp)) continue;
+      const Next next = !rendered ? expand<kRays>(s, w, wr, it, st, cap, sp)
+                        : s.done  ? Next::kStop
+                                  : Next::kPop;
+      if (next == Next::kEnter) continue;
+      if (next == Next::kStop) return;
       do {
-        if (sp == 0 || s.done) return;
+        if (sp == 0) return;
         it = st[--sp];
       } while (it.t > s.ray.tmax);
     }
   }
 
+  /// What the walk does after a node: enter `it` (the nearest hit child), pop the stack, or
+  /// stop (the ray is done: a shadow ray occluded). `done` is read only where it can have
+  /// changed (after a leaf or a rendered amalgam), not at every pop.
+  enum class Next { kEnter, kPop, kStop };
+
   /// Always inlined into the pop loop: as a call per node it cost register saves and restores
   /// and the box kernel's per-ray constants were set up again for every node (inlining it, with
   /// the pushes straight onto the stack below, took the engine primary rays from 2 578 to
-  /// 2 133 instructions per ray; docs/benchmarks.md). Returns true when `it` is now the nearest
-  /// hit child, to be entered next (the other hit children are on the stack).
-  template <bool kZeroAxes>
-  [[gnu::always_inline]] bool expand(State& s, const WideNodes& w, const WideRay& wr, StackItem& it,
+  /// 2 133 instructions per ray; docs/benchmarks.md). kEnter: `it` is now the nearest hit
+  /// child, to be entered next (the other hit children are on the stack).
+  template <BoxRays kRays>
+  [[gnu::always_inline]] Next expand(State& s, const WideNodes& w, const WideRay& wr, StackItem& it,
                                      StackItem*& st, std::size_t& cap, std::size_t& sp) {
     const WideHeader hd = w.headers[it.node];
     const int cl = it.level + 1;
     const int count = hd.count;
     if (hd.leaf == kWideTriangleLeaf) {
       leaf_triangles(s, w, wr, hd, cl);
-      return false;
+      return s.done ? Next::kStop : Next::kPop;
     }
-    if (hd.leaf) {
+    if (hd.leaf == kWideLeaf) {
       for (int i = 0; i < count; ++i) {
         s.counters.count_test(s.kind, ObjectKind::kPrimitive, cl);
         primitive(s, hd.first + static_cast<std::uint32_t>(i), cl);
-        if (s.done) return false;
+        if (s.done) return Next::kStop;
       }
-      return false;
+      return Next::kPop;
     }
     const ObjectKind ok = s.object_kind(cl);
     for (int i = 0; i < count; ++i) s.counters.count_test(s.kind, ok, cl);
@@ -131,26 +140,29 @@ class WideWalk {
 #endif
     if (count <= kOneCall) {
       alignas(32) float t[kOneCall];
-      unsigned mask;
-#if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
-      if (count > kWideLanes)
-        mask = intersect_wide8<kZeroAxes>(blk[0], blk[1], wr, s.ray.tmin, s.ray.tmax, count, t);
-      else
-#endif
-        mask = intersect_wide4<kZeroAxes>(*blk, wr, s.ray.tmin, s.ray.tmax, count, t);
-      if (mask == 0) return false;
-      if ((mask & (mask - 1)) == 0) {
-        const int lane = std::countr_zero(mask);
-        it = {t[lane], hd.first + static_cast<std::uint32_t>(lane), cl};
-        return true;
+      const unsigned mask = boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, count, t);
+      if (mask == 0) return Next::kPop;
+      const int l0 = std::countr_zero(mask);
+      const unsigned rest = mask & (mask - 1);
+      if (rest == 0) {
+        it = {t[l0], hd.first + static_cast<std::uint32_t>(l0), cl};
+        return Next::kEnter;
       }
       if (sp + count > cap) {
         stack_.resize(2 * cap + count);
         st = stack_.data(), cap = stack_.size();
       }
-      push_sorted(st, sp, mask, t, hd.first, cl);
+      if ((rest & (rest - 1)) == 0) {  // two hits: one comparison (ties: the first in order)
+        const int l1 = std::countr_zero(rest);
+        const bool second = t[l1] < t[l0];
+        const int near = second ? l1 : l0, far = second ? l0 : l1;
+        st[sp++] = {t[far], hd.first + static_cast<std::uint32_t>(far), cl};
+        it = {t[near], hd.first + static_cast<std::uint32_t>(near), cl};
+        return Next::kEnter;
+      }
+      push_sorted(st, sp, mask, t, hd.first, cl, sp);
       it = st[--sp];
-      return true;
+      return Next::kEnter;
     }
     if (sp + count > cap) {
       stack_.resize(2 * cap + count);
@@ -162,20 +174,34 @@ class WideWalk {
     for (; count - c0 > kWideLanes; c0 += 2 * kWideLanes, blk += 2) {
       alignas(32) float t[2 * kWideLanes];
       const int m = std::min(count - c0, 2 * kWideLanes);
-      push_sorted(st, sp,
-                  intersect_wide8<kZeroAxes>(blk[0], blk[1], wr, s.ray.tmin, s.ray.tmax, m, t), t,
+      push_sorted(st, sp, boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, m, t), t,
                   hd.first + static_cast<std::uint32_t>(c0), cl, base);
     }
 #endif
     for (; c0 < count; c0 += kWideLanes, ++blk) {
       alignas(16) float t[kWideLanes];
       const int m = std::min(count - c0, kWideLanes);
-      push_sorted(st, sp, intersect_wide4<kZeroAxes>(*blk, wr, s.ray.tmin, s.ray.tmax, m, t), t,
+      push_sorted(st, sp, boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, m, t), t,
                   hd.first + static_cast<std::uint32_t>(c0), cl, base);
     }
-    if (sp == base) return false;
+    if (sp == base) return Next::kPop;
     it = st[--sp];
-    return true;
+    return Next::kEnter;
+  }
+
+  /// The first `m` boxes of the blocks at `blk` (m <= 8 with AVX2, <= 4 otherwise): one
+  /// kernel call.
+  template <BoxRays kRays>
+  [[gnu::always_inline]] static unsigned boxes(const WideBox4* blk, const WideRay& wr, float tmin,
+                                               float tmax, int m, float* t) {
+#if AMALGAM_WIDE_SSE
+#if defined(AMALGAM_ISA_AVX2)
+    if (m > kWideLanes) return box_test_lanes<BoxLanes8, kRays>(blk, wr, tmin, tmax, m, t);
+#endif
+    return box_test_lanes<BoxLanes4, kRays>(blk, wr, tmin, tmax, m, t);
+#else
+    return intersect_wide4(*blk, wr, tmin, tmax, m, t);  // the scalar test: exact for any ray
+#endif
   }
 
   /// Pushes the lanes of `mask` (children `first + lane`, entered at `t[lane]`) onto the stack
@@ -192,10 +218,6 @@ class WideWalk {
       while (i > base && st[i - 1].t <= te) st[i] = st[i - 1], --i;
       st[i] = {te, first + static_cast<std::uint32_t>(lane), level};
     }
-  }
-  [[gnu::always_inline]] static void push_sorted(StackItem* st, std::size_t& sp, unsigned mask,
-                                                 const float* t, std::uint32_t first, int level) {
-    push_sorted(st, sp, mask, t, first, level, sp);
   }
 
   /// A triangle-only leaf, four triangles at a time (`triangle_test4`; eight, from two packs,
