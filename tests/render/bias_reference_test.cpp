@@ -81,7 +81,10 @@ std::vector<TileRect> checked_tiles() {
 
 struct TileStats {
   double luminance = 0;  ///< mean over the tile's pixels
-  double amalgams = 0;   ///< share of the samples whose camera ray did not end at a primitive
+  /// Share of the samples whose camera ray did not end at a primitive. The ground covers the
+  /// frame (no sample misses at full detail), so these ended at a rendered amalgam or in a
+  /// saturated blend of translucent ones.
+  double amalgams = 0;
 };
 
 struct Measured {
