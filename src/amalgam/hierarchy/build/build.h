@@ -41,7 +41,7 @@ struct MemoryModel {
 /// Build settings for `build_explicit` and `build_instanced`.
 struct BuildConfig {
   int arity = 8;      ///< children per interior node (2..kMaxChildren)
-  int leaf_size = 8;  ///< at most this many primitives in a leaf (1..kMaxChildren)
+  int leaf_size = 4;  ///< at most this many primitives in a leaf (1..kMaxChildren)
   int bins = 16;      ///< SAH bins per axis
   bool parallel = true;
   BakeConfig bake;
