@@ -20,7 +20,7 @@ namespace amalgam::test {
 unsigned avx2_triangle_test8(const TrianglePack4 p[2], const Ray& ray, float tmin, float tmax,
                              int n, float out[5][8]) {
   TrianglePackHitsN<8> h;
-  const unsigned mask = triangle_test_lanes<TriangleLanes8>(p, WideRay::of(ray), tmin, tmax, n, h);
+  const unsigned mask = triangle_test_lanes<Lanes8>(p, WideRay::of(ray), tmin, tmax, n, h);
   for (int i = 0; i < 8; ++i)
     out[0][i] = h.t[i], out[1][i] = h.u[i], out[2][i] = h.v[i], out[3][i] = h.w[i],
     out[4][i] = h.det[i];
@@ -28,8 +28,8 @@ unsigned avx2_triangle_test8(const TrianglePack4 p[2], const Ray& ray, float tmi
 }
 
 unsigned avx2_box_test8(const WideBox4 b[2], const Ray& ray, int n, float t_entry[8]) {
-  return box_test_lanes<BoxLanes8, BoxRays::kZeroAxes>(b, WideRay::of(ray), ray.tmin, ray.tmax, n,
-                                                       t_entry);
+  return box_test_lanes<Lanes8, BoxRays::kZeroAxes>(b, WideRay::of(ray), ray.tmin, ray.tmax, n,
+                                                    t_entry);
 }
 
 }  // namespace amalgam::test

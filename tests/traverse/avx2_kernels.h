@@ -8,12 +8,12 @@
 
 namespace amalgam::test {
 
-/// `triangle_test_lanes<TriangleLanes8>` on the packs p[0], p[1] (first `n` lanes, 1..8): the
+/// `triangle_test_lanes<Lanes8>` on the packs p[0], p[1] (first `n` lanes, 1..8): the
 /// hit mask; out[0..4][lane] = t, u, v, w, det of each hit lane.
 unsigned avx2_triangle_test8(const TrianglePack4 p[2], const Ray& ray, float tmin, float tmax,
                              int n, float out[5][8]);
 
-/// `box_test_lanes<BoxLanes8, BoxRays::kZeroAxes>` on the blocks b[0], b[1] (first `n`
+/// `box_test_lanes<Lanes8, BoxRays::kZeroAxes>` on the blocks b[0], b[1] (first `n`
 /// lanes) against `ray` over [ray.tmin, ray.tmax]: the hit mask, entry t per lane.
 unsigned avx2_box_test8(const WideBox4 b[2], const Ray& ray, int n, float t_entry[8]);
 

@@ -66,59 +66,96 @@ struct WideRay {
   }
 };
 
+#if AMALGAM_WIDE_SSE
+/// The vector operations of the box and triangle kernels: 4 lanes (SSE) from one block or
+/// pack...
+struct Lanes4 {
+  using V = __m128;
+  static constexpr int kLanes = 4;
+  /// The floats at `byte_offset` in block `b` (a WideBox4's lo or hi of one axis).
+  static V load(const WideBox4* b, std::uint32_t byte_offset) {
+    return _mm_load_ps(
+        reinterpret_cast<const float*>(reinterpret_cast<const char*>(b) + byte_offset));
+  }
+  /// One coordinate of one vertex of the triangles of pack `p`.
+  static V load(const TrianglePack4* p, int vertex, int axis) {
+    return _mm_load_ps(p[0].v[vertex][axis]);
+  }
+  static V load_aligned(const float* d) { return _mm_load_ps(d); }
+  static V set1(float x) { return _mm_set1_ps(x); }
+  static V zero() { return _mm_setzero_ps(); }
+  static V all() { return _mm_castsi128_ps(_mm_set1_epi32(-1)); }
+  static V add(V a, V b) { return _mm_add_ps(a, b); }
+  static V sub(V a, V b) { return _mm_sub_ps(a, b); }
+  static V mul(V a, V b) { return _mm_mul_ps(a, b); }
+  static V div(V a, V b) { return _mm_div_ps(a, b); }
+  static V min(V a, V b) { return _mm_min_ps(a, b); }
+  static V max(V a, V b) { return _mm_max_ps(a, b); }
+  static V eq(V a, V b) { return _mm_cmpeq_ps(a, b); }
+  static V lt(V a, V b) { return _mm_cmplt_ps(a, b); }
+  static V gt(V a, V b) { return _mm_cmpgt_ps(a, b); }
+  static V ge(V a, V b) { return _mm_cmpge_ps(a, b); }
+  static V le(V a, V b) { return _mm_cmple_ps(a, b); }
+  static V nlt(V a, V b) { return _mm_cmpnlt_ps(a, b); }
+  static V ngt(V a, V b) { return _mm_cmpngt_ps(a, b); }
+  static V bor(V a, V b) { return _mm_or_ps(a, b); }
+  static V band(V a, V b) { return _mm_and_ps(a, b); }
+  static V andnot(V a, V b) { return _mm_andnot_ps(a, b); }
+  static unsigned mask(V a) { return static_cast<unsigned>(_mm_movemask_ps(a)); }
+  static void store(float* d, V a) { _mm_storeu_ps(d, a); }
+  static const V* origin(const WideRay& r) { return r.o4; }
+  static const V* inv(const WideRay& r) { return r.inv4; }
+  static const V* shear(const WideRay& r) { return r.shear4; }
+  static const V* sheared_origin(const WideRay& r) { return r.ok4; }
+};
+#if defined(AMALGAM_ISA_AVX2)
+/// ... or 8 lanes (AVX) from two consecutive blocks or packs. Without FMA (the build does not
+/// enable it), each lane performs exactly the SSE form's operations.
+struct Lanes8 {
+  using V = __m256;
+  static constexpr int kLanes = 8;
+  static V load(const WideBox4* b, std::uint32_t byte_offset) {
+    return _mm256_set_m128(Lanes4::load(b + 1, byte_offset), Lanes4::load(b, byte_offset));
+  }
+  static V load(const TrianglePack4* p, int vertex, int axis) {
+    return _mm256_set_m128(_mm_load_ps(p[1].v[vertex][axis]), _mm_load_ps(p[0].v[vertex][axis]));
+  }
+  static V load_aligned(const float* d) { return _mm256_load_ps(d); }
+  static V set1(float x) { return _mm256_set1_ps(x); }
+  static V zero() { return _mm256_setzero_ps(); }
+  static V all() { return _mm256_castsi256_ps(_mm256_set1_epi32(-1)); }
+  static V add(V a, V b) { return _mm256_add_ps(a, b); }
+  static V sub(V a, V b) { return _mm256_sub_ps(a, b); }
+  static V mul(V a, V b) { return _mm256_mul_ps(a, b); }
+  static V div(V a, V b) { return _mm256_div_ps(a, b); }
+  static V min(V a, V b) { return _mm256_min_ps(a, b); }
+  static V max(V a, V b) { return _mm256_max_ps(a, b); }
+  static V eq(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_EQ_OQ); }
+  static V lt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LT_OQ); }
+  static V gt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GT_OQ); }
+  static V ge(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GE_OQ); }
+  static V le(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LE_OQ); }
+  static V nlt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_NLT_US); }
+  static V ngt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_NGT_US); }
+  static V bor(V a, V b) { return _mm256_or_ps(a, b); }
+  static V band(V a, V b) { return _mm256_and_ps(a, b); }
+  static V andnot(V a, V b) { return _mm256_andnot_ps(a, b); }
+  static unsigned mask(V a) { return static_cast<unsigned>(_mm256_movemask_ps(a)); }
+  static void store(float* d, V a) { _mm256_storeu_ps(d, a); }
+  static const V* origin(const WideRay& r) { return r.o8; }
+  static const V* inv(const WideRay& r) { return r.inv8; }
+  static const V* shear(const WideRay& r) { return r.shear8; }
+  static const V* sheared_origin(const WideRay& r) { return r.ok8; }
+};
+#endif
+#endif
+
 /// How the box kernel may treat a ray's axes: kZeroAxes, a direction component may be zero
 /// (that axis is a containment test, as in intersect_box); kNonZero, none is (`!r.any_zero`),
 /// so the per-axis branch of that case is left out.
 enum class BoxRays { kZeroAxes, kNonZero };
 
 #if AMALGAM_WIDE_SSE
-/// The vector operations of the box kernel, 4 lanes (SSE) from one block...
-struct BoxLanes4 {
-  using V = __m128;
-  static constexpr int kLanes = 4;
-  static V load(const WideBox4* b, std::uint32_t byte_offset) {
-    return _mm_load_ps(
-        reinterpret_cast<const float*>(reinterpret_cast<const char*>(b) + byte_offset));
-  }
-  static V set1(float x) { return _mm_set1_ps(x); }
-  static V all() { return _mm_castsi128_ps(_mm_set1_epi32(-1)); }
-  static V sub(V a, V b) { return _mm_sub_ps(a, b); }
-  static V mul(V a, V b) { return _mm_mul_ps(a, b); }
-  static V min(V a, V b) { return _mm_min_ps(a, b); }
-  static V max(V a, V b) { return _mm_max_ps(a, b); }
-  static V le(V a, V b) { return _mm_cmple_ps(a, b); }
-  static V nlt(V a, V b) { return _mm_cmpnlt_ps(a, b); }
-  static V ngt(V a, V b) { return _mm_cmpngt_ps(a, b); }
-  static V band(V a, V b) { return _mm_and_ps(a, b); }
-  static unsigned mask(V a) { return static_cast<unsigned>(_mm_movemask_ps(a)); }
-  static void store(float* d, V a) { _mm_storeu_ps(d, a); }
-  static const V* origin(const WideRay& r) { return r.o4; }
-  static const V* inv(const WideRay& r) { return r.inv4; }
-};
-#if defined(AMALGAM_ISA_AVX2)
-/// ... or 8 lanes (AVX) from two consecutive blocks.
-struct BoxLanes8 {
-  using V = __m256;
-  static constexpr int kLanes = 8;
-  static V load(const WideBox4* b, std::uint32_t byte_offset) {
-    return _mm256_set_m128(BoxLanes4::load(b + 1, byte_offset), BoxLanes4::load(b, byte_offset));
-  }
-  static V set1(float x) { return _mm256_set1_ps(x); }
-  static V all() { return _mm256_castsi256_ps(_mm256_set1_epi32(-1)); }
-  static V sub(V a, V b) { return _mm256_sub_ps(a, b); }
-  static V mul(V a, V b) { return _mm256_mul_ps(a, b); }
-  static V min(V a, V b) { return _mm256_min_ps(a, b); }
-  static V max(V a, V b) { return _mm256_max_ps(a, b); }
-  static V le(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LE_OQ); }
-  static V nlt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_NLT_US); }
-  static V ngt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_NGT_US); }
-  static V band(V a, V b) { return _mm256_and_ps(a, b); }
-  static unsigned mask(V a) { return static_cast<unsigned>(_mm256_movemask_ps(a)); }
-  static void store(float* d, V a) { _mm256_storeu_ps(d, a); }
-  static const V* origin(const WideRay& r) { return r.o8; }
-  static const V* inv(const WideRay& r) { return r.inv8; }
-};
-#endif
 
 /// Tests the first `n` (1..L::kLanes) boxes of the blocks at `b` against the ray over [tmin,
 /// tmax], exactly as `intersect_box` would one at a time. Returns the lanes hit as a bit mask;
@@ -170,7 +207,7 @@ template <bool kZeroAxes = true>
 inline unsigned intersect_wide4(const WideBox4& b, const WideRay& r, float tmin, float tmax, int n,
                                 float t_entry[kWideLanes]) {
 #if AMALGAM_WIDE_SSE
-  return box_test_lanes < BoxLanes4,
+  return box_test_lanes < Lanes4,
          kZeroAxes ? BoxRays::kZeroAxes : BoxRays::kNonZero > (&b, r, tmin, tmax, n, t_entry);
 #else
   unsigned mask = 0;
@@ -198,63 +235,6 @@ struct alignas(32) TrianglePackHitsN {
 using TrianglePackHits = TrianglePackHitsN<kWideLanes>;
 
 #if AMALGAM_WIDE_SSE
-/// The vector operations the triangle kernel needs, 4 lanes (SSE) from one pack...
-struct TriangleLanes4 {
-  using V = __m128;
-  static constexpr int kLanes = 4;
-  static V load(const TrianglePack4* p, int vertex, int axis) {
-    return _mm_load_ps(p[0].v[vertex][axis]);
-  }
-  static V set1(float x) { return _mm_set1_ps(x); }
-  static V zero() { return _mm_setzero_ps(); }
-  static V add(V a, V b) { return _mm_add_ps(a, b); }
-  static V sub(V a, V b) { return _mm_sub_ps(a, b); }
-  static V mul(V a, V b) { return _mm_mul_ps(a, b); }
-  static V div(V a, V b) { return _mm_div_ps(a, b); }
-  static V eq(V a, V b) { return _mm_cmpeq_ps(a, b); }
-  static V lt(V a, V b) { return _mm_cmplt_ps(a, b); }
-  static V gt(V a, V b) { return _mm_cmpgt_ps(a, b); }
-  static V ge(V a, V b) { return _mm_cmpge_ps(a, b); }
-  static V le(V a, V b) { return _mm_cmple_ps(a, b); }
-  static V bor(V a, V b) { return _mm_or_ps(a, b); }
-  static V band(V a, V b) { return _mm_and_ps(a, b); }
-  static V andnot(V a, V b) { return _mm_andnot_ps(a, b); }
-  static unsigned mask(V a) { return static_cast<unsigned>(_mm_movemask_ps(a)); }
-  static void store(float* d, V a) { _mm_store_ps(d, a); }
-  static V load_aligned(const float* d) { return _mm_load_ps(d); }
-  static const V* shear(const WideRay& r) { return r.shear4; }
-  static const V* origin(const WideRay& r) { return r.ok4; }
-};
-#if defined(AMALGAM_ISA_AVX2)
-/// ... or 8 lanes (AVX) from two consecutive packs. Without FMA (the build does not enable
-/// it), each lane performs exactly the SSE form's operations.
-struct TriangleLanes8 {
-  using V = __m256;
-  static constexpr int kLanes = 8;
-  static V load(const TrianglePack4* p, int vertex, int axis) {
-    return _mm256_set_m128(_mm_load_ps(p[1].v[vertex][axis]), _mm_load_ps(p[0].v[vertex][axis]));
-  }
-  static V set1(float x) { return _mm256_set1_ps(x); }
-  static V zero() { return _mm256_setzero_ps(); }
-  static V add(V a, V b) { return _mm256_add_ps(a, b); }
-  static V sub(V a, V b) { return _mm256_sub_ps(a, b); }
-  static V mul(V a, V b) { return _mm256_mul_ps(a, b); }
-  static V div(V a, V b) { return _mm256_div_ps(a, b); }
-  static V eq(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_EQ_OQ); }
-  static V lt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LT_OQ); }
-  static V gt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GT_OQ); }
-  static V ge(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GE_OQ); }
-  static V le(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LE_OQ); }
-  static V bor(V a, V b) { return _mm256_or_ps(a, b); }
-  static V band(V a, V b) { return _mm256_and_ps(a, b); }
-  static V andnot(V a, V b) { return _mm256_andnot_ps(a, b); }
-  static unsigned mask(V a) { return static_cast<unsigned>(_mm256_movemask_ps(a)); }
-  static void store(float* d, V a) { _mm256_store_ps(d, a); }
-  static V load_aligned(const float* d) { return _mm256_load_ps(d); }
-  static const V* shear(const WideRay& r) { return r.shear8; }
-  static const V* origin(const WideRay& r) { return r.ok8; }
-};
-#endif
 
 /// `triangle_test` on the first `n` (1..L::kLanes) triangles of the packs at `p` at once, each
 /// against the same [tmin, tmax]: the hit lanes as a bit mask, their t and barycentrics in
@@ -273,7 +253,7 @@ inline unsigned triangle_test_lanes(const TrianglePack4* p, const WideRay& r, fl
   const unsigned lanes = (1u << n) - 1u;
   const int kx = pre.kx, ky = pre.ky, kz = pre.kz;
   const V* shear = L::shear(r);
-  const V* org = L::origin(r);
+  const V* org = L::sheared_origin(r);
   const V sx = shear[0], sy = shear[1], sz = shear[2];
   const V ox = org[0], oy = org[1], oz = org[2];
   // Sheared and translated vertices (scalar: A[kx] - sx * A[kz] with A = a - origin).
@@ -340,7 +320,7 @@ inline unsigned triangle_test_lanes(const TrianglePack4* p, const WideRay& r, fl
 inline unsigned triangle_test4(const TrianglePack4& p, const WideRay& r, float tmin, float tmax,
                                int n, TrianglePackHits& out) {
 #if AMALGAM_WIDE_SSE
-  return triangle_test_lanes<TriangleLanes4>(&p, r, tmin, tmax, n, out);
+  return triangle_test_lanes<Lanes4>(&p, r, tmin, tmax, n, out);
 #else
   const TrianglePre& pre = r.pre;
   Ray ray;

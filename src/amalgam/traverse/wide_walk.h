@@ -196,9 +196,9 @@ class WideWalk {
                                                float tmax, int m, float* t) {
 #if AMALGAM_WIDE_SSE
 #if defined(AMALGAM_ISA_AVX2)
-    if (m > kWideLanes) return box_test_lanes<BoxLanes8, kRays>(blk, wr, tmin, tmax, m, t);
+    if (m > kWideLanes) return box_test_lanes<Lanes8, kRays>(blk, wr, tmin, tmax, m, t);
 #endif
-    return box_test_lanes<BoxLanes4, kRays>(blk, wr, tmin, tmax, m, t);
+    return box_test_lanes<Lanes4, kRays>(blk, wr, tmin, tmax, m, t);
 #else
     return intersect_wide4(*blk, wr, tmin, tmax, m, t);  // the scalar test: exact for any ray
 #endif
@@ -236,7 +236,7 @@ class WideWalk {
       TrianglePackHitsN<2 * kWideLanes> c;
       const int m = std::min(count - c0, 2 * kWideLanes);
       if (!take(s, hd, level, c0, m,
-                triangle_test_lanes<TriangleLanes8>(pack, wr, s.ray.tmin, s.ray.tmax, m, c), c))
+                triangle_test_lanes<Lanes8>(pack, wr, s.ray.tmin, s.ray.tmax, m, c), c))
         return;
     }
 #endif
