@@ -71,14 +71,14 @@ TEST(Isa, Avx2CopyGivesThePortableBits) {
   std::vector<LoadedScene> scenes;
   scenes.push_back(load_scene("builtin:demo", Params("builtin:demo")));
   scenes.push_back(load_scene("builtin:line", Params("builtin:line")));
-  // explicit, the default 8-wide nodes (intersect_wide8) and leaves of up to 8 triangles
-  // (the 8-lane triangle kernel over two packs)
+  // explicit, the default 8-wide nodes (the 8-lane box kernel) and leaves of up to 4
+  // triangles (one pack)
   scenes.push_back(load_scene(wuson, Params(wuson)));
   scenes.push_back(load_scene(std::string(AMALGAM_SOURCE_DIR) + "/scenes/wuson-grid.json",
                               Params("grid")));  // instanced
   for (const int arity : {4, 13}) {
     // 4-wide nodes and leaves (one SSE-width block, one pack); 13: several kernel calls per
-    // node (8 + 4 + 1 boxes) and per leaf (8 + 4 + 1 triangles).
+    // node (8 + 4 + 1 boxes) and per leaf (8 + 4 + 1 triangles: the 8-lane triangle kernel).
     LoadedScene w = load_scene(wuson, Params(wuson));
     const auto& e = std::get<ExplicitHierarchy>(w.hierarchy);
     BuildConfig c;

@@ -148,10 +148,7 @@ class WideWalk {
         it = {t[l0], hd.first + static_cast<std::uint32_t>(l0), cl};
         return Next::kEnter;
       }
-      if (sp + count > cap) {
-        stack_.resize(2 * cap + count);
-        st = stack_.data(), cap = stack_.size();
-      }
+      reserve(st, cap, sp + count);
       if ((rest & (rest - 1)) == 0) {  // two hits: one comparison (ties: the first in order)
         const int l1 = std::countr_zero(rest);
         const bool second = t[l1] < t[l0];
@@ -164,10 +161,7 @@ class WideWalk {
       it = st[--sp];
       return Next::kEnter;
     }
-    if (sp + count > cap) {
-      stack_.resize(2 * cap + count);
-      st = stack_.data(), cap = stack_.size();
-    }
+    reserve(st, cap, sp + count);
     const std::size_t base = sp;
     int c0 = 0;
 #if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
@@ -187,6 +181,13 @@ class WideWalk {
     if (sp == base) return Next::kPop;
     it = st[--sp];
     return Next::kEnter;
+  }
+
+  /// Grows the stack to hold `need` items (the base and capacity are the loop's locals).
+  [[gnu::always_inline]] void reserve(StackItem*& st, std::size_t& cap, std::size_t need) {
+    if (need <= cap) return;
+    stack_.resize(2 * cap + need);
+    st = stack_.data(), cap = stack_.size();
   }
 
   /// The first `m` boxes of the blocks at `blk` (m <= 8 with AVX2, <= 4 otherwise): one
