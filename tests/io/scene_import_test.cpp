@@ -171,6 +171,63 @@ TEST(Texture, AmalgamsBakeTheMeanTextureColourTimesTheFactor) {
   EXPECT_GT(atlas.mean.x * factor.x, 10.0f * dark.x);  // what the texels' mean would give
 }
 
+TEST(Texture, CopiesOfATexturedTriangleBakeItsColourAndOthersTheirOwn) {
+  // The bake computes a texture's mean once per distinct (material, coordinates): copies share
+  // it, and any other coordinates or material get their own. Three variants of one small
+  // triangle (over the dark texels only, over the bright ones, the dark ones under a second
+  // material), each copied 1,500 times far apart (4,500 triangles: the parallel path), one
+  // triangle per leaf, so that every leaf's colour is its triangle's.
+  Texture tex;  // texels dark, dark, bright, bright, clamped
+  tex.width = 4, tex.height = 1;
+  tex.texels = {20, 20, 20, 20, 20, 20, 240, 240, 240, 240, 240, 240};
+  tex.wrap_u = tex.wrap_v = Wrap::kClamp;
+  finish_texture(tex);
+  Surface dim, bright;
+  dim.colour = {0.5f, 0.5f, 0.5f}, dim.texture = 0;
+  bright.colour = {1.0f, 0.25f, 1.0f}, bright.texture = 0;
+  TexCoords left, right;
+  left.u[0] = 0.05f, left.u[1] = 0.35f, left.u[2] = 0.05f;     // dark texels only
+  right.u[0] = 0.65f, right.u[1] = 0.95f, right.u[2] = 0.65f;  // bright only
+  for (TexCoords* c : {&left, &right}) c->v[0] = 0.1f, c->v[1] = 0.1f, c->v[2] = 0.9f;
+  struct Variant {
+    TexCoords uv;
+    std::uint32_t material;
+  };
+  const Variant variants[3] = {{left, 0}, {right, 0}, {left, 1}};
+  std::vector<Primitive> prims;
+  std::vector<TexCoords> uvs;
+  for (int k = 0; k < 4500; ++k) {
+    const Vec3 at{static_cast<float>(k % 75) * 3.0f, static_cast<float>(k / 75) * 3.0f, 0};
+    prims.push_back(
+        Primitive::triangle(at, at + Vec3{1, 0, 0}, at + Vec3{0, 1, 0}, variants[k % 3].material));
+    uvs.push_back(variants[k % 3].uv);
+  }
+  auto textures = std::make_shared<const std::vector<Texture>>(std::vector<Texture>{tex});
+  for (const bool parallel : {true, false}) {
+    BuildConfig cfg;
+    cfg.leaf_size = 1;
+    cfg.parallel = parallel;
+    cfg.bake.rays = 32;
+    const ExplicitHierarchy h = build_explicit(prims, {dim, bright}, cfg, uvs, textures);
+    const Vec3 want[3] = {dim.colour * srgb_to_linear(20), dim.colour * srgb_to_linear(240),
+                          bright.colour * srgb_to_linear(20)};
+    int checked = 0;
+    for (std::size_t i = 0; i < h.nodes.size(); ++i) {
+      const ExplicitNode& n = h.nodes[i];
+      if (!n.leaf || h.appearances[i].opacity == 0.0f) continue;
+      ASSERT_EQ(n.count, 1u);
+      const PrimId p = n.first;
+      const int v = (h.uvs[p].u[0] > 0.5f ? 1 : 0) + (h.prims[p].material == 1 ? 2 : 0);
+      ASSERT_LT(v, 3);
+      const Vec3 got = h.appearances[i].surface.colour;
+      ASSERT_NEAR(got.x, want[v].x, 1e-5f) << "leaf " << i << ", variant " << v;
+      ASSERT_NEAR(got.y, want[v].y, 1e-5f) << "leaf " << i << ", variant " << v;
+      ++checked;
+    }
+    EXPECT_GT(checked, 4000) << parallel;
+  }
+}
+
 TEST(Texture, BoxTexturedImportsItsTextureAndEveryVariantTheSameImage) {
   REQUIRE_MODELS();
   const ImportedMesh plain = import_mesh((kGltf / "BoxTextured-glTF/BoxTextured.gltf").string());

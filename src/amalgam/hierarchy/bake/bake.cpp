@@ -2,11 +2,15 @@
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <bit>
 #include <span>
+#include <utility>
 #include <vector>
 
+#include "amalgam/geometry/intersect.h"
 #include "amalgam/hierarchy/bake/combine.h"
 #include "amalgam/hierarchy/bake/lines.h"
 #include "amalgam/hierarchy/bake/orientation.h"
@@ -51,6 +55,81 @@ std::vector<int> node_levels(const std::vector<ExplicitNode>& nodes) {
   return level;
 }
 
+/// Textured: each primitive's bake colour (its texture's mean over its coordinates, up to
+/// 4096 texture samples), computed once per primitive (every exact bake above it would
+/// otherwise average the texture again) and once per distinct (material, coordinates): the
+/// copies of a small textured mesh that a scene expands instead of instancing share them
+/// (200 spiders: 262,400 triangles, 1,312 distinct; the bake went from 13.5 s to 0.1 s).
+/// Empty when the hierarchy has no textures.
+std::vector<Vec3> bake_colours(const ExplicitHierarchy& h, bool parallel) {
+  std::vector<Vec3> colours;
+  if (!h.textures || h.textures->empty()) return colours;
+  const std::size_t n = h.prims.size();
+  colours.resize(n);
+  auto key_words = [&](std::size_t p, std::uint32_t w[7]) {
+    w[0] = h.prims[p].material;
+    if (h.uvs.empty()) {
+      std::fill(w + 1, w + 7, 0u);
+      return;
+    }
+    const TexCoords& c = h.uvs[p];
+    for (int i = 0; i < 3; ++i) {
+      w[1 + i] = std::bit_cast<std::uint32_t>(c.u[i]);
+      w[4 + i] = std::bit_cast<std::uint32_t>(c.v[i]);
+    }
+  };
+  // Primitives ordered by a hash of their key; a run of equal hashes is split by the keys
+  // themselves, so a collision only costs a second computation.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> order(n);
+  auto hash_range = [&](std::size_t b, std::size_t e) {
+    for (std::size_t p = b; p < e; ++p) {
+      std::uint32_t w[7];
+      key_words(p, w);
+      std::uint64_t k = 0x636f6c6f;
+      for (std::uint32_t x : w) k = hash_combine(k, x);
+      order[p] = {k, static_cast<std::uint32_t>(p)};
+    }
+  };
+  const bool par = parallel && n > 4096;
+  if (par) {
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, n, 4096),
+        [&](const tbb::blocked_range<std::size_t>& r) { hash_range(r.begin(), r.end()); });
+    tbb::parallel_sort(order.begin(), order.end());
+  } else {
+    hash_range(0, n);
+    std::sort(order.begin(), order.end());
+  }
+  std::vector<std::size_t> runs;  // starts of the runs of equal hashes, then n
+  for (std::size_t i = 0; i < n; ++i)
+    if (i == 0 || order[i].first != order[i - 1].first) runs.push_back(i);
+  runs.push_back(n);
+  auto fill = [&](std::size_t rb, std::size_t re) {
+    for (std::size_t r = rb; r < re; ++r) {
+      const std::size_t b = runs[r], e = runs[r + 1];
+      for (std::size_t i = b; i < e; ++i) {
+        const std::uint32_t p = order[i].second;
+        std::uint32_t w[7];
+        key_words(p, w);
+        bool done = false;
+        for (std::size_t j = b; j < i && !done; ++j) {  // an earlier one with the same key
+          std::uint32_t x[7];
+          key_words(order[j].second, x);
+          if (std::equal(w, w + 7, x)) colours[p] = colours[order[j].second], done = true;
+        }
+        if (!done) colours[p] = h.bake_colour(p);
+      }
+    }
+  };
+  const std::size_t groups = runs.size() - 1;
+  if (par)
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups, 256),
+                      [&](const tbb::blocked_range<std::size_t>& r) { fill(r.begin(), r.end()); });
+  else
+    fill(0, groups);
+  return colours;
+}
+
 /// Exact bake of node `id`: random lines traced (closest hit) against its subtree.
 /// `orientation`: closed_orientation of the hierarchy's primitives (0: triangles have no
 /// known outside, so the result is never kOriented when one is hit). `colours`: each
@@ -72,15 +151,31 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
     for (float& x : u) x = s.next();
     u[0] = (static_cast<float>(r) + u[0]) / static_cast<float>(rays);
     Ray ray = sample_line(box, u);
+    // Closest hit along the line. Triangles: the per-line set-up once and the SurfaceHit of
+    // the closest one only (what intersect() gives, without building it for every hit).
+    const TrianglePre pre = TrianglePre::of(ray);
+    TriangleCandidate cand{};
+    bool cand_best = false;  // the closest hit so far is the triangle candidate `cand`
     std::optional<SurfaceHit> best;
     std::uint32_t best_prim = 0;
-    const ExplicitNode& top = h.nodes[id];
-    if (top.leaf) {  // the common case: no stack
-      for (std::uint32_t p = top.first; p < top.first + top.count; ++p)
-        if (auto hit = intersect(h.prims[p], ray)) {
-          best = hit, best_prim = p;
+    auto leaf = [&](const ExplicitNode& n) {
+      for (std::uint32_t p = n.first; p < n.first + n.count; ++p) {
+        const Primitive& prim = h.prims[p];
+        if (prim.kind == PrimKind::kTriangle) {
+          TriangleCandidate c;  // a failed test may leave partial values in it
+          if (triangle_test(ray, pre, prim.a, prim.b, prim.c, c)) {
+            cand = c, cand_best = true, best_prim = p;
+            ray.tmax = cand.t;
+          }
+        } else if (auto hit = intersect(prim, ray)) {
+          cand_best = false, best = hit, best_prim = p;
           ray.tmax = hit->t;
         }
+      }
+    };
+    const ExplicitNode& top = h.nodes[id];
+    if (top.leaf) {  // the common case: no stack
+      leaf(top);
     } else {
       stack.assign(1, id);
     }
@@ -89,14 +184,14 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
       stack.pop_back();
       if (!intersect_box(ray, n.bounds)) continue;
       if (n.leaf) {
-        for (std::uint32_t p = n.first; p < n.first + n.count; ++p)
-          if (auto hit = intersect(h.prims[p], ray)) {
-            best = hit, best_prim = p;
-            ray.tmax = hit->t;
-          }
+        leaf(n);
       } else {
         for (std::uint32_t c = 0; c < n.count; ++c) stack.push_back(n.first + c);
       }
+    }
+    if (cand_best) {
+      const Primitive& bp = h.prims[best_prim];
+      best = triangle_finish(ray, bp.a, bp.b, bp.c, cand);
     }
     if (!best) continue;
     ++hits;
@@ -128,21 +223,7 @@ void bake(ExplicitHierarchy& h, const BakeConfig& config) {
   const int orientation =
       h.prims.size() <= config.orient_max_triangles ? closed_orientation(h.prims) : 0;
   h.appearances.assign(n, Appearance{});
-  // Textured: each primitive's colour, its texture's mean over its coordinates, computed once
-  // (every exact bake above it would otherwise average the texture again).
-  std::vector<Vec3> colours;
-  if (h.textures && !h.textures->empty()) {
-    colours.resize(h.prims.size());
-    auto fill = [&](std::size_t b, std::size_t e) {
-      for (std::size_t p = b; p < e; ++p) colours[p] = h.bake_colour(p);
-    };
-    if (config.parallel && colours.size() > 4096)
-      tbb::parallel_for(
-          tbb::blocked_range<std::size_t>(0, colours.size(), 1024),
-          [&](const tbb::blocked_range<std::size_t>& r) { fill(r.begin(), r.end()); });
-    else
-      fill(0, colours.size());
-  }
+  const std::vector<Vec3> colours = bake_colours(h, config.parallel);
   std::vector<NormalTensor> tensors(n);
   std::vector<std::uint64_t> prims_below(n, 0);
   const std::vector<int> level = node_levels(h.nodes);

@@ -16,8 +16,13 @@ Vec3 dominant_normal(const NormalTensor& t) {
     const Vec3 y = t.apply(x);
     const float len = length(y);
     if (!(len > 0.0f)) return {};
-    x = y / len;
+    const Vec3 next = y / len;
     lambda = len;
+    // A fixed point of the float iteration stays one: stopping there returns what the
+    // remaining iterations would (most nodes' tensors are nearly rank one and get there in a
+    // few steps).
+    if (next == x) break;
+    x = next;
   }
   if (lambda < kPlanarity * tr) return {};
   return x;
