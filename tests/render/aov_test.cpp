@@ -112,6 +112,33 @@ TEST(Aov, BackgroundPrimitivesAndRenderedLevels) {
   EXPECT_GT(on_level, 0);
 }
 
+TEST(Aov, ACompositeBlendThatSaturatesIsWhereTheRayEnded) {
+  // tests/data/bias-meadow.json: grass on ground that fills the frame. A camera ray ends at a
+  // primitive, at a rendered amalgam, or in a blend of translucent amalgams that saturates
+  // (composite opacity), whose depth and level are those of the amalgam that saturated it.
+  // (They were reported as "nothing met": level -1, depth +inf, for about half the pixels.)
+  // Only a ray that crosses the grass without saturating and then misses the ground (in the
+  // top rows, beyond its far edge) meets nothing: 10 of these 3,072.
+  const LoadedScene s =
+      load_scene(std::string(AMALGAM_SOURCE_DIR) + "/tests/data/bias-meadow.json", Params{});
+  RenderOptions o;
+  o.opacity = OpacityKind::kComposite;
+  o.footprint = 2;
+  o.width = 64, o.height = 48, o.spp = 1, o.threads = 2;
+  const RenderOutput out = render(s, o);
+  int nothing = 0, amalgams = 0;
+  for (std::size_t i = 0; i < out.level.size(); ++i) {
+    if (out.level[i] == -1.0f) {
+      ++nothing;
+      continue;
+    }
+    ASSERT_TRUE(std::isfinite(out.depth[i])) << "pixel " << i;
+    if (out.level[i] >= 0) ++amalgams;
+  }
+  EXPECT_LT(nothing, 31) << "of " << out.level.size() << " pixels";
+  EXPECT_GT(amalgams, static_cast<int>(out.level.size()) / 4);  // the far grass
+}
+
 TEST(Aov, OlderCheckpointFormatIsRefusedInOneLine) {
   const std::string path =
       (std::filesystem::temp_directory_path() / ("amalgam-old-" + std::to_string(getpid())))

@@ -124,6 +124,7 @@ class Integrator {
     float through = 1.0f;
     std::uint64_t none = 0;  // unshadowed shading traces no ray
     members_.clear();
+    std::size_t saturated_at = translucent_.size();  // the member whose blend saturates
     for (std::size_t k = 0; k < translucent_.size() && translucent_[k].t < t_end; ++k) {
       const TranslucentHit& a = translucent_[k];
       const Appearance app = h_.appearance(a.id);
@@ -133,8 +134,14 @@ class Integrator {
       r.normal += amalgam_normal(app, a.surf, wo) * w;
       r.albedo += app.surface.colour * w;
       through *= 1.0f - a.opacity;
+      if (saturated_at == translucent_.size() && through < kSaturatedTransmittance)
+        saturated_at = k;
     }
     if (through < kSaturatedTransmittance) {
+      // The ray ended there (the traversal stopped looking beyond that depth): the depth and
+      // level outputs are those of the member that saturated the blend.
+      const TranslucentHit& e = translucent_[saturated_at];
+      r.hit = TraceHit{TraceHit::Kind::kAmalgam, e.t, e.id, e.level, e.surf};
       // Saturated (the traversal stops there): the little left is taken to look like the
       // blend, whose weights are scaled up to sum to 1, rather than like nothing.
       const float scale = 1.0f / (1.0f - through);
