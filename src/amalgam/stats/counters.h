@@ -33,6 +33,12 @@ struct Counters {
     ++tests[static_cast<int>(r)][static_cast<int>(o)];
     ++by_level[static_cast<unsigned>(level) < kCountedLevels ? level : kCountedLevels - 1];
   }
+  /// `n` tests of one kind on one level at once (a node's children tested together): the
+  /// same counts as n calls of count_test, in two additions.
+  void count_tests(RayKind r, ObjectKind o, int level, std::uint64_t n) {
+    tests[static_cast<int>(r)][static_cast<int>(o)] += n;
+    by_level[static_cast<unsigned>(level) < kCountedLevels ? level : kCountedLevels - 1] += n;
+  }
   void count_ray(RayKind r) { ++rays[static_cast<int>(r)]; }
   void count_reached(RayKind r) { ++reached[static_cast<int>(r)]; }
 
@@ -61,6 +67,7 @@ struct Counters {
 /// The Counters interface with every operation a no-op: the compiler removes the counting.
 struct NullCounters {
   void count_test(RayKind, ObjectKind, int) {}
+  void count_tests(RayKind, ObjectKind, int, std::uint64_t) {}
   void count_ray(RayKind) {}
   void count_reached(RayKind) {}
   std::uint64_t total() const { return 0; }

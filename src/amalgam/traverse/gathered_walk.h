@@ -74,7 +74,7 @@ class GatheredWalk {
       return;
     }
     const ObjectKind ok = s.object_kind(cl);
-    for (int i = 0; i < count; ++i) s.counters.count_test(s.kind, ok, cl);
+    s.counters.count_tests(s.kind, ok, cl, static_cast<std::uint64_t>(count));
     const bool may_render = State::kMayRender && s.lod.may_render(cl);
     Item hits[kMaxChildren];
     int n = 0;
