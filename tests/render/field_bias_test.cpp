@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <numbers>
+#include <random>
 
 #include "amalgam/geometry/intersect.h"
 #include "amalgam/hierarchy/bake/lines.h"
@@ -143,6 +144,30 @@ TEST(ClosedOrientation, TellsClosedOutwardInwardAndOpen) {
   // Wuson.ply comes with assimp-testmodels, which scripts/deps.sh installs: missing is a failure.
   ASSERT_TRUE(std::filesystem::exists(kWusonPath)) << kWusonPath << " (assimp-testmodels)";
   EXPECT_NE(closed_orientation(import_mesh(kWusonPath).triangles), 0) << "Wuson.ply is closed";
+}
+
+TEST(ClosedOrientation, ManyTrianglesTakeTheBucketedSort) {
+  // 800 boxes (9,600 triangles, 28,800 directed edges: the edges are sorted in buckets above
+  // 16,384 keys) answer as one box does.
+  std::vector<Primitive> boxes;
+  for (int i = 0; i < 800; ++i)
+    for (const Primitive& t :
+         closed_box({static_cast<float>(i % 40) * 2, 0, static_cast<float>(i / 40) * 2},
+                    {static_cast<float>(i % 40) * 2 + 1, 1, static_cast<float>(i / 40) * 2 + 1}))
+      boxes.push_back(t);
+  ASSERT_EQ(boxes.size(), 9600u);
+  // In random order, so that the two sides of an edge are far apart before the sort.
+  std::mt19937 rng(7);
+  std::shuffle(boxes.begin(), boxes.end(), rng);
+  EXPECT_EQ(closed_orientation(boxes), 1);
+  std::vector<Primitive> inward = boxes;
+  for (Primitive& t : inward) std::swap(t.b, t.c);
+  EXPECT_EQ(closed_orientation(inward), -1);
+  std::vector<Primitive> flipped = boxes;  // one triangle wound the other way
+  std::swap(flipped[4800].b, flipped[4800].c);
+  EXPECT_EQ(closed_orientation(flipped), 0);
+  std::vector<Primitive> holes(boxes.begin(), boxes.end() - 900);  // about 3 of 36 unmatched
+  EXPECT_EQ(closed_orientation(holes), 0);
 }
 
 TEST(ClosedOrientation, AFinelyTessellatedOpenSheetIsOpen) {
