@@ -92,7 +92,7 @@ TEST(SahBuild, ParallelEqualsSerialAndEdgeCases) {
   EXPECT_EQ(a.order, b.order);
   for (std::size_t i = 0; i < a.nodes.size(); ++i) EXPECT_EQ(a.nodes[i].bounds, b.nodes[i].bounds);
   // Empty input: one empty leaf. Identical boxes: still a valid tree.
-  const SahTree e = build_sah({});
+  const SahTree e = build_sah(std::span<const Bbox>{});
   ASSERT_EQ(e.nodes.size(), 1u);
   EXPECT_TRUE(e.nodes[0].leaf);
   EXPECT_EQ(e.nodes[0].count, 0u);

@@ -67,8 +67,7 @@ ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surfa
       for (std::size_t i = 0; i < n; ++i) f(i);
   };
   each(prims.size(), [&](std::size_t i) { boxes[i] = bounds(prims[i]); });
-  SahTree t = build_sah(boxes, sah_config(config));
-  boxes = {};
+  SahTree t = build_sah(std::move(boxes), sah_config(config));
   h.prims.resize(prims.size());
   each(prims.size(), [&](std::size_t i) { h.prims[i] = prims[t.order[i]]; });
   prims = {};
@@ -100,7 +99,7 @@ InstancedHierarchy build_instanced(std::vector<ExplicitHierarchy> meshes,
   // Top level: binned SAH over the instances' world boxes.
   std::vector<Bbox> boxes(h.instances.size());
   for (std::size_t i = 0; i < boxes.size(); ++i) boxes[i] = h.instances[i].world_bounds;
-  const SahTree t = build_sah(boxes, sah_config(config));
+  const SahTree t = build_sah(std::move(boxes), sah_config(config));
   h.top_items = t.order;
   h.top_nodes = explicit_nodes(t);
   h.levels = t.depth + 2;

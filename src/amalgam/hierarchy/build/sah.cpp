@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
-#include <numeric>
 
 #include "amalgam/hierarchy/hierarchy.h"
 #include "amalgam/util/check.h"
@@ -47,27 +46,41 @@ struct Bins {
   std::vector<Bin> bins;
 };
 
+/// An item as the builder moves it: its box and its index. Binning and partitioning read the
+/// items in place, in order (a node's items are contiguous), instead of gathering boxes and
+/// centroids through an index array; the centroid is the box's centre, computed when needed.
+struct Ref {
+  Bbox box;
+  std::uint32_t item;
+};
+
 class BinaryBuilder {
  public:
-  BinaryBuilder(std::span<const Bbox> boxes, const SahConfig& c) : boxes_(boxes), cfg_(c) {
+  BinaryBuilder(std::span<const Bbox> boxes, const SahConfig& c) : cfg_(c) {
     const auto n = static_cast<std::uint32_t>(boxes.size());
-    cent_.resize(n);
-    idx_.resize(n);
-    std::iota(idx_.begin(), idx_.end(), 0u);
-    for (std::uint32_t i = 0; i < n; ++i) cent_[i] = boxes[i].center();
-    nodes_.resize(std::max<std::size_t>(1, 2 * static_cast<std::size_t>(n)));
+    refs_.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) refs_[i] = {boxes[i], i};
     bins_ = std::clamp(cfg_.bins, 2, kMaxBins);
     leaf_ = static_cast<std::uint32_t>(std::clamp(cfg_.leaf_size, 1, kMaxChildren));
   }
 
   void run() {
+    nodes_.resize(std::max<std::size_t>(1, 2 * refs_.size()));
     Bbox box, cbox;
-    for (std::uint32_t i = 0; i < idx_.size(); ++i) box.extend(boxes_[i]), cbox.extend(cent_[i]);
-    build(0, 0, static_cast<std::uint32_t>(idx_.size()), box, cbox);
+    for (const Ref& r : refs_) box.extend(r.box), cbox.extend(r.box.center());
+    build(0, 0, static_cast<std::uint32_t>(refs_.size()), box, cbox);
   }
 
+  /// The same, freeing `boxes` once copied (before the nodes are allocated: a lower peak).
+  BinaryBuilder(std::vector<Bbox>&& boxes, const SahConfig& c)
+      : BinaryBuilder(std::span<const Bbox>(boxes), c) {
+    boxes = {};
+  }
+
+  /// Item i of the final order (leaves' items are ranges of it).
+  std::uint32_t item(std::size_t i) const { return refs_[i].item; }
+
   std::vector<BinaryNode> nodes_;
-  std::vector<std::uint32_t> idx_;
 
  private:
   Bins bin(std::uint32_t begin, std::uint32_t end, const Bbox& cbox, int nb) const {
@@ -76,12 +89,12 @@ class BinaryBuilder {
     for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0 ? nb / ext[a] : 0.0f;
     auto fill = [&](std::uint32_t b, std::uint32_t e, Bins& out) {
       for (std::uint32_t i = b; i < e; ++i) {
-        const std::uint32_t item = idx_[i];
-        const Vec3 c = cent_[item];
+        const Bbox& item = refs_[i].box;
+        const Vec3 c = item.center();
         for (int a = 0; a < 3; ++a) {
           const int k = bin_of((c[a] - lo[a]) * scale[a], nb);
           Bin& bin = out.axis(a)[k];
-          bin.box.extend(boxes_[item]);
+          bin.box.extend(item);
           bin.cbox.extend(c);
           ++bin.n;
         }
@@ -162,12 +175,11 @@ class BinaryBuilder {
       const float lo = cbox.lo[best_axis];
       const float scale = nb / ext[best_axis];
       const int bins = nb, k = best_k, a = best_axis;
-      mid = static_cast<std::uint32_t>(std::partition(idx_.begin() + begin, idx_.begin() + end,
-                                                      [&](std::uint32_t item) {
-                                                        return bin_of((cent_[item][a] - lo) * scale,
-                                                                      bins) <= k;
-                                                      }) -
-                                       idx_.begin());
+      mid = static_cast<std::uint32_t>(
+          std::partition(
+              refs_.begin() + begin, refs_.begin() + end,
+              [&](const Ref& r) { return bin_of((r.box.center()[a] - lo) * scale, bins) <= k; }) -
+          refs_.begin());
     } else {
       mid = begin + count / 2;  // all centroids coincide: any split is as good
     }
@@ -175,9 +187,9 @@ class BinaryBuilder {
       mid = begin + count / 2;
       lbox = rbox = lcbox = rcbox = Bbox{};
       for (std::uint32_t i = begin; i < mid; ++i)
-        lbox.extend(boxes_[idx_[i]]), lcbox.extend(cent_[idx_[i]]);
+        lbox.extend(refs_[i].box), lcbox.extend(refs_[i].box.center());
       for (std::uint32_t i = mid; i < end; ++i)
-        rbox.extend(boxes_[idx_[i]]), rcbox.extend(cent_[idx_[i]]);
+        rbox.extend(refs_[i].box), rcbox.extend(refs_[i].box.center());
     }
     const std::uint32_t left = next_.fetch_add(2, std::memory_order_relaxed);
     out.leaf = false, out.a = left, out.b = left + 1;
@@ -190,26 +202,21 @@ class BinaryBuilder {
     }
   }
 
-  std::span<const Bbox> boxes_;
   SahConfig cfg_;
-  std::vector<Vec3> cent_;
+  std::vector<Ref> refs_;
   int bins_ = 16;
   std::uint32_t leaf_ = 4;
   std::atomic<std::uint32_t> next_{1};
 };
 
-}  // namespace
-
-SahTree build_sah(std::span<const Bbox> boxes, const SahConfig& config) {
-  BinaryBuilder b(boxes, config);
-  b.run();
+SahTree collapse(const BinaryBuilder& b, std::size_t items, const SahConfig& config) {
   const auto& bin = b.nodes_;
   const auto arity = static_cast<std::size_t>(std::clamp(config.arity, 2, kMaxChildren));
 
   // Collapse breadth-first: open the child with the largest surface area until a node has
   // `arity` children (or only leaves are left).
   SahTree t;
-  t.order.reserve(boxes.size());
+  t.order.reserve(items);
   t.nodes.push_back({bin[0].box, 0, 0, true});
   t.level.push_back(0);
   std::vector<std::uint32_t> queue{0};  // binary node of wide node q
@@ -222,7 +229,7 @@ SahTree build_sah(std::span<const Bbox> boxes, const SahConfig& config) {
       t.nodes[q].first = static_cast<std::uint32_t>(t.order.size());
       t.nodes[q].count = checked_narrow<std::uint16_t>(n.b, "SAH leaf size");
       t.nodes[q].leaf = true;
-      t.order.insert(t.order.end(), b.idx_.begin() + n.a, b.idx_.begin() + n.a + n.b);
+      for (std::uint32_t k = n.a; k < n.a + n.b; ++k) t.order.push_back(b.item(k));
       continue;
     }
     kids = {n.a, n.b};
@@ -249,6 +256,21 @@ SahTree build_sah(std::span<const Bbox> boxes, const SahConfig& config) {
     }
   }
   return t;
+}
+
+}  // namespace
+
+SahTree build_sah(std::span<const Bbox> boxes, const SahConfig& config) {
+  BinaryBuilder b(boxes, config);
+  b.run();
+  return collapse(b, boxes.size(), config);
+}
+
+SahTree build_sah(std::vector<Bbox>&& boxes, const SahConfig& config) {
+  const std::size_t items = boxes.size();
+  BinaryBuilder b(std::move(boxes), config);
+  b.run();
+  return collapse(b, items, config);
 }
 
 }  // namespace amalgam

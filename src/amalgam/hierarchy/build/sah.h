@@ -44,5 +44,8 @@ struct SahTree {
 /// Builds the tree. Empty input gives a single empty leaf. Every item is in exactly one leaf;
 /// every node's box is the union of its children's boxes.
 SahTree build_sah(std::span<const Bbox> boxes, const SahConfig& config = {});
+/// The same, taking the boxes over: they are freed once copied, before the tree's nodes are
+/// allocated (a lower peak of memory).
+SahTree build_sah(std::vector<Bbox>&& boxes, const SahConfig& config = {});
 
 }  // namespace amalgam
