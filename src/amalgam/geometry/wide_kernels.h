@@ -298,12 +298,21 @@ inline unsigned triangle_test_lanes(const TrianglePack4* p, const WideRay& r, fl
   L::store(out.t, t), L::store(out.u, u), L::store(out.v, v);
   L::store(out.w, w), L::store(out.det, det);
   unsigned hits = L::mask(L::andnot(bad, in)) & lanes;
-  if (hits) {
-    // The scalar test's rejection of t within its rounding error, lane by lane on the same
-    // operands (triangle_t_error).
+  if (!hits) return 0;
+  // The scalar test's rejection of t within its rounding error (triangle_t_error). Its first
+  // case for all lanes at once: a triangle wholly on the side of the origin that the ray
+  // faces (the z of its vertices all of the sign of sz) has no error bound, 0, so only t <= 0
+  // is rejected; the compares are those of the scalar code on the same operands.
+  const V ahead = pre.sz > 0.0f
+                      ? L::band(L::band(L::gt(Z[0], zero), L::gt(Z[1], zero)), L::gt(Z[2], zero))
+                      : L::band(L::band(L::lt(Z[0], zero), L::lt(Z[1], zero)), L::lt(Z[2], zero));
+  const unsigned near = L::mask(ahead) & hits;
+  hits &= ~(L::mask(L::le(t, zero)) & near);
+  if (const unsigned rest = hits & ~near) {
+    // The other lanes one by one on the same operands.
     alignas(32) float x[3][N], y[3][N], z[3][N];
     for (int k = 0; k < 3; ++k) L::store(x[k], X[k]), L::store(y[k], Y[k]), L::store(z[k], Z[k]);
-    for (unsigned m = hits; m; m &= m - 1) {
+    for (unsigned m = rest; m; m &= m - 1) {
       const int i = std::countr_zero(m);
       if (out.t[i] <= triangle_t_error(x[0][i], y[0][i], x[1][i], y[1][i], x[2][i], y[2][i],
                                        z[0][i], z[1][i], z[2][i], pre.sz, out.u[i], out.v[i],

@@ -236,7 +236,7 @@ class WideWalk {
   /// against the same tmax) a lane is taken in leaf order when its t is still <= tmax (ties:
   /// the later one, as there); a shadow ray stops at the first hit in leaf order, having tested
   /// the triangles up to and including it.
-  static void leaf_triangles(State& s, const TrianglePack4* pack, const WideRay& wr,
+  [[gnu::always_inline]] static void leaf_triangles(State& s, const TrianglePack4* pack, const WideRay& wr,
                              std::uint32_t first, int count, int level) {
     int c0 = 0;
 #if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
