@@ -1,5 +1,6 @@
 #include "amalgam/hierarchy/wide.h"
 
+#include <algorithm>
 #include <limits>
 
 #include "amalgam/hierarchy/explicit.h"
@@ -26,6 +27,7 @@ void build_wide(ExplicitHierarchy& h) {
     hd.first = n.first;
     hd.count = n.count;
     hd.leaf = n.leaf ? kWideLeaf : kWideInterior;
+    hd.lanes = n.leaf ? 0 : static_cast<std::uint8_t>((1u << std::min<int>(n.count, 8)) - 1u);
     hd.block = static_cast<std::uint32_t>(w.blocks.size());
     if (n.leaf) {
       bool triangles = n.count > 0;

@@ -33,6 +33,9 @@ struct WideHeader {
   std::uint32_t block = 0;
   std::uint16_t count = 0;
   std::uint8_t leaf = kWideInterior;
+  /// Interior nodes: the bit mask of the first min(count, 8) lanes, (1 << that) - 1, so that
+  /// the traversal masks off a block's unused lanes with one load.
+  std::uint8_t lanes = 0;
 };
 
 struct WideNodes {

@@ -149,7 +149,11 @@ class WideWalk {
 #endif
     if (count <= kOneCall) {
       alignas(32) float t[kOneCall];
-      const unsigned mask = boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, count, t);
+      // The kernel tests all lanes of the block(s); the header's mask keeps the children's.
+      const unsigned mask =
+          (count > kWideLanes ? boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, kOneCall, t)
+                              : boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, kWideLanes, t)) &
+          hd.lanes;
       if (mask == 0) return Next::kPop;
       const int l0 = std::countr_zero(mask);
       const unsigned rest = mask & (mask - 1);
