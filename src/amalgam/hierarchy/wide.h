@@ -40,7 +40,9 @@ struct WideHeader {
 
 struct WideNodes {
   std::vector<WideHeader> headers;  ///< one per node
-  std::vector<WideBox4> blocks;     ///< children's boxes of every interior node
+  /// Children's boxes of every interior node, and one spare block at the end (an 8-lane read
+  /// of the last node's single block stays inside the vector).
+  std::vector<WideBox4> blocks;
   std::vector<TrianglePack4> tris;  ///< triangles of every triangle-only leaf, leaf order
   std::size_t bytes() const {
     return headers.size() * sizeof(WideHeader) + blocks.size() * sizeof(WideBox4) +

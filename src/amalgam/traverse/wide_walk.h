@@ -149,11 +149,10 @@ class WideWalk {
 #endif
     if (count <= kOneCall) {
       alignas(32) float t[kOneCall];
-      // The kernel tests all lanes of the block(s); the header's mask keeps the children's.
-      const unsigned mask =
-          (count > kWideLanes ? boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, kOneCall, t)
-                              : boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, kWideLanes, t)) &
-          hd.lanes;
+      // The kernel tests all lanes of kOneCall / 4 blocks (a node of up to 4 children reads
+      // the block after its own too: no branch on the count, and WideNodes keeps a spare block
+      // at the end); the header's mask keeps the children's lanes.
+      const unsigned mask = boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, kOneCall, t) & hd.lanes;
       if (mask == 0) return Next::kPop;
       const int l0 = std::countr_zero(mask);
       const unsigned rest = mask & (mask - 1);
