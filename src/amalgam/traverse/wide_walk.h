@@ -241,6 +241,12 @@ class WideWalk {
   /// the triangles up to and including it.
   [[gnu::always_inline]] static void leaf_triangles(State& s, const TrianglePack4* pack, const WideRay& wr,
                              std::uint32_t first, int count, int level) {
+    if (count <= kWideLanes) {  // one pack (the default leaves): no loop to set up
+      TrianglePackHits c;
+      take(s, first, level, 0, count, triangle_test4(*pack, wr, s.ray.tmin, s.ray.tmax, count, c),
+           c);
+      return;
+    }
     int c0 = 0;
 #if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
     for (; count - c0 > kWideLanes; c0 += 2 * kWideLanes, pack += 2) {
