@@ -109,15 +109,31 @@ struct Lanes4 {
   static unsigned mask(V a) { return static_cast<unsigned>(_mm_movemask_ps(a)); }
   static void store(float* d, V a) { _mm_storeu_ps(d, a); }
 #if defined(AMALGAM_ISA_AVX2)
-  static V origin(const WideRay& r, int a) { return _mm256_castps256_ps128(r.o8[a]); }
-  static V inv(const WideRay& r, int a) { return _mm256_castps256_ps128(r.inv8[a]); }
-  static V shear(const WideRay& r, int a) { return _mm256_castps256_ps128(r.shear8[a]); }
-  static V sheared_origin(const WideRay& r, int a) { return _mm256_castps256_ps128(r.ok8[a]); }
+  static V origin(const WideRay& r, int a) {
+    return _mm256_castps256_ps128(r.o8[a]);
+  }
+  static V inv(const WideRay& r, int a) {
+    return _mm256_castps256_ps128(r.inv8[a]);
+  }
+  static V shear(const WideRay& r, int a) {
+    return _mm256_castps256_ps128(r.shear8[a]);
+  }
+  static V sheared_origin(const WideRay& r, int a) {
+    return _mm256_castps256_ps128(r.ok8[a]);
+  }
 #else
-  static V origin(const WideRay& r, int a) { return r.o4[a]; }
-  static V inv(const WideRay& r, int a) { return r.inv4[a]; }
-  static V shear(const WideRay& r, int a) { return r.shear4[a]; }
-  static V sheared_origin(const WideRay& r, int a) { return r.ok4[a]; }
+  static V origin(const WideRay& r, int a) {
+    return r.o4[a];
+  }
+  static V inv(const WideRay& r, int a) {
+    return r.inv4[a];
+  }
+  static V shear(const WideRay& r, int a) {
+    return r.shear4[a];
+  }
+  static V sheared_origin(const WideRay& r, int a) {
+    return r.ok4[a];
+  }
 #endif
 };
 #if defined(AMALGAM_ISA_AVX2)

@@ -239,8 +239,9 @@ class WideWalk {
   /// against the same tmax) a lane is taken in leaf order when its t is still <= tmax (ties:
   /// the later one, as there); a shadow ray stops at the first hit in leaf order, having tested
   /// the triangles up to and including it.
-  [[gnu::always_inline]] static void leaf_triangles(State& s, const TrianglePack4* pack, const WideRay& wr,
-                             std::uint32_t first, int count, int level) {
+  [[gnu::always_inline]] static void leaf_triangles(State& s, const TrianglePack4* pack,
+                                                    const WideRay& wr, std::uint32_t first,
+                                                    int count, int level) {
     if (count <= kWideLanes) {  // one pack (the default leaves): no loop to set up
       TrianglePackHits c;
       take(s, first, level, 0, count, triangle_test4(*pack, wr, s.ray.tmin, s.ray.tmax, count, c),
