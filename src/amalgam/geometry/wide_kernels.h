@@ -30,13 +30,16 @@ struct WideRay {
   TrianglePre pre;  ///< the watertight triangle test's setup (TrianglePre::of)
 #if AMALGAM_WIDE_SSE
   // Broadcast once per ray, so the kernels read them as memory operands instead of
-  // broadcasting them again for every node and leaf.
-  __m128 o4[3], inv4[3];
-  __m128 shear4[3];  ///< pre.sx, pre.sy, pre.sz
-  __m128 ok4[3];     ///< o[pre.kx], o[pre.ky], o[pre.kz]
+  // broadcasting them again for every node and leaf. The AVX2 copy keeps only the 8-wide
+  // forms: the 4-wide kernels read their lower halves (the same bits), which saved the
+  // broadcasts and stores of the 4-wide set per ray.
 #if defined(AMALGAM_ISA_AVX2)
   __m256 o8[3], inv8[3];
-  __m256 shear8[3], ok8[3];  ///< as shear4, ok4, for the 8-wide triangle test
+  __m256 shear8[3];  ///< pre.sx, pre.sy, pre.sz
+  __m256 ok8[3];     ///< o[pre.kx], o[pre.ky], o[pre.kz]
+#else
+  __m128 o4[3], inv4[3];
+  __m128 shear4[3], ok4[3];  ///< as shear8, ok8
 #endif
 #endif
   static WideRay of(const Ray& r) {
@@ -44,22 +47,24 @@ struct WideRay {
     for (int a = 0; a < 3; ++a) {
       w.o[a] = r.origin[a], w.inv[a] = r.inv_dir[a], w.zero[a] = r.dir[a] == 0.0f;
 #if AMALGAM_WIDE_SSE
-      w.o4[a] = _mm_set1_ps(w.o[a]), w.inv4[a] = _mm_set1_ps(w.inv[a]);
 #if defined(AMALGAM_ISA_AVX2)
       w.o8[a] = _mm256_set1_ps(w.o[a]), w.inv8[a] = _mm256_set1_ps(w.inv[a]);
+#else
+      w.o4[a] = _mm_set1_ps(w.o[a]), w.inv4[a] = _mm_set1_ps(w.inv[a]);
 #endif
 #endif
     }
     w.any_zero = w.zero[0] || w.zero[1] || w.zero[2];
     w.pre = TrianglePre::of(r);
 #if AMALGAM_WIDE_SSE
-    w.shear4[0] = _mm_set1_ps(w.pre.sx), w.shear4[1] = _mm_set1_ps(w.pre.sy);
-    w.shear4[2] = _mm_set1_ps(w.pre.sz);
-    w.ok4[0] = w.o4[w.pre.kx], w.ok4[1] = w.o4[w.pre.ky], w.ok4[2] = w.o4[w.pre.kz];
 #if defined(AMALGAM_ISA_AVX2)
     w.shear8[0] = _mm256_set1_ps(w.pre.sx), w.shear8[1] = _mm256_set1_ps(w.pre.sy);
     w.shear8[2] = _mm256_set1_ps(w.pre.sz);
     w.ok8[0] = w.o8[w.pre.kx], w.ok8[1] = w.o8[w.pre.ky], w.ok8[2] = w.o8[w.pre.kz];
+#else
+    w.shear4[0] = _mm_set1_ps(w.pre.sx), w.shear4[1] = _mm_set1_ps(w.pre.sy);
+    w.shear4[2] = _mm_set1_ps(w.pre.sz);
+    w.ok4[0] = w.o4[w.pre.kx], w.ok4[1] = w.o4[w.pre.ky], w.ok4[2] = w.o4[w.pre.kz];
 #endif
 #endif
     return w;
@@ -103,10 +108,33 @@ struct Lanes4 {
   static V andnot(V a, V b) { return _mm_andnot_ps(a, b); }
   static unsigned mask(V a) { return static_cast<unsigned>(_mm_movemask_ps(a)); }
   static void store(float* d, V a) { _mm_storeu_ps(d, a); }
-  static const V* origin(const WideRay& r) { return r.o4; }
-  static const V* inv(const WideRay& r) { return r.inv4; }
-  static const V* shear(const WideRay& r) { return r.shear4; }
-  static const V* sheared_origin(const WideRay& r) { return r.ok4; }
+#if defined(AMALGAM_ISA_AVX2)
+  static V origin(const WideRay& r, int a) {
+    return _mm256_castps256_ps128(r.o8[a]);
+  }
+  static V inv(const WideRay& r, int a) {
+    return _mm256_castps256_ps128(r.inv8[a]);
+  }
+  static V shear(const WideRay& r, int a) {
+    return _mm256_castps256_ps128(r.shear8[a]);
+  }
+  static V sheared_origin(const WideRay& r, int a) {
+    return _mm256_castps256_ps128(r.ok8[a]);
+  }
+#else
+  static V origin(const WideRay& r, int a) {
+    return r.o4[a];
+  }
+  static V inv(const WideRay& r, int a) {
+    return r.inv4[a];
+  }
+  static V shear(const WideRay& r, int a) {
+    return r.shear4[a];
+  }
+  static V sheared_origin(const WideRay& r, int a) {
+    return r.ok4[a];
+  }
+#endif
 };
 #if defined(AMALGAM_ISA_AVX2)
 /// ... or 8 lanes (AVX) from two consecutive blocks or packs. Without FMA (the build does not
@@ -142,10 +170,10 @@ struct Lanes8 {
   static V andnot(V a, V b) { return _mm256_andnot_ps(a, b); }
   static unsigned mask(V a) { return static_cast<unsigned>(_mm256_movemask_ps(a)); }
   static void store(float* d, V a) { _mm256_storeu_ps(d, a); }
-  static const V* origin(const WideRay& r) { return r.o8; }
-  static const V* inv(const WideRay& r) { return r.inv8; }
-  static const V* shear(const WideRay& r) { return r.shear8; }
-  static const V* sheared_origin(const WideRay& r) { return r.ok8; }
+  static V origin(const WideRay& r, int a) { return r.o8[a]; }
+  static V inv(const WideRay& r, int a) { return r.inv8[a]; }
+  static V shear(const WideRay& r, int a) { return r.shear8[a]; }
+  static V sheared_origin(const WideRay& r, int a) { return r.ok8[a]; }
 };
 #endif
 #endif
@@ -174,14 +202,14 @@ inline unsigned box_test_lanes(const WideBox4* b, const WideRay& r, float tmin, 
   V t_near = L::set1(-kInfinity), t_far = L::set1(kInfinity);
   V ok = L::all();
   for (int a = 0; a < 3; ++a) {
-    const V o = L::origin(r)[a];
+    const V o = L::origin(r, a);
     const std::uint32_t axis = static_cast<std::uint32_t>(a * kWideLanes * sizeof(float));
     const V lo = L::load(b, kLo + axis), hi = L::load(b, kHi + axis);
     if (kRays == BoxRays::kZeroAxes && r.zero[a]) {  // scalar: if (o < lo || o > hi) miss
       ok = L::band(ok, L::band(L::nlt(o, lo), L::ngt(o, hi)));
       continue;
     }
-    const V inv = L::inv(r)[a];
+    const V inv = L::inv(r, a);
     const V t0 = L::mul(L::sub(lo, o), inv);
     const V t1 = L::mul(L::sub(hi, o), inv);
     // scalar: if (t0 > t1) swap. minps(x, y) = x < y ? x : y; maxps(x, y) = x > y ? x : y.
@@ -252,10 +280,9 @@ inline unsigned triangle_test_lanes(const TrianglePack4* p, const WideRay& r, fl
   const TrianglePre& pre = r.pre;
   const unsigned lanes = (1u << n) - 1u;
   const int kx = pre.kx, ky = pre.ky, kz = pre.kz;
-  const V* shear = L::shear(r);
-  const V* org = L::sheared_origin(r);
-  const V sx = shear[0], sy = shear[1], sz = shear[2];
-  const V ox = org[0], oy = org[1], oz = org[2];
+  const V sx = L::shear(r, 0), sy = L::shear(r, 1), sz = L::shear(r, 2);
+  const V ox = L::sheared_origin(r, 0), oy = L::sheared_origin(r, 1);
+  const V oz = L::sheared_origin(r, 2);
   // Sheared and translated vertices (scalar: A[kx] - sx * A[kz] with A = a - origin).
   V X[3], Y[3], Z[3];
   for (int k = 0; k < 3; ++k) {
@@ -298,12 +325,21 @@ inline unsigned triangle_test_lanes(const TrianglePack4* p, const WideRay& r, fl
   L::store(out.t, t), L::store(out.u, u), L::store(out.v, v);
   L::store(out.w, w), L::store(out.det, det);
   unsigned hits = L::mask(L::andnot(bad, in)) & lanes;
-  if (hits) {
-    // The scalar test's rejection of t within its rounding error, lane by lane on the same
-    // operands (triangle_t_error).
+  if (!hits) return 0;
+  // The scalar test's rejection of t within its rounding error (triangle_t_error). Its first
+  // case for all lanes at once: a triangle wholly on the side of the origin that the ray
+  // faces (the z of its vertices all of the sign of sz) has no error bound, 0, so only t <= 0
+  // is rejected; the compares are those of the scalar code on the same operands.
+  const V ahead = pre.sz > 0.0f
+                      ? L::band(L::band(L::gt(Z[0], zero), L::gt(Z[1], zero)), L::gt(Z[2], zero))
+                      : L::band(L::band(L::lt(Z[0], zero), L::lt(Z[1], zero)), L::lt(Z[2], zero));
+  const unsigned near = L::mask(ahead) & hits;
+  hits &= ~(L::mask(L::le(t, zero)) & near);
+  if (const unsigned rest = hits & ~near) {
+    // The other lanes one by one on the same operands.
     alignas(32) float x[3][N], y[3][N], z[3][N];
     for (int k = 0; k < 3; ++k) L::store(x[k], X[k]), L::store(y[k], Y[k]), L::store(z[k], Z[k]);
-    for (unsigned m = hits; m; m &= m - 1) {
+    for (unsigned m = rest; m; m &= m - 1) {
       const int i = std::countr_zero(m);
       if (out.t[i] <= triangle_t_error(x[0][i], y[0][i], x[1][i], y[1][i], x[2][i], y[2][i],
                                        z[0][i], z[1][i], z[2][i], pre.sz, out.u[i], out.v[i],

@@ -1,5 +1,6 @@
 #include "amalgam/hierarchy/wide.h"
 
+#include <algorithm>
 #include <limits>
 
 #include "amalgam/hierarchy/explicit.h"
@@ -18,7 +19,7 @@ void build_wide(ExplicitHierarchy& h) {
   std::size_t n_blocks = 0, n_packs = 0;
   for (const ExplicitNode& n : h.nodes)
     (n.leaf ? n_packs : n_blocks) += (n.count + kWideLanes - 1) / kWideLanes;
-  w.blocks.reserve(n_blocks);
+  w.blocks.reserve(n_blocks + 1);
   w.tris.reserve(n_packs);  // an upper bound: leaves with spheres or boxes take none
   for (std::size_t i = 0; i < h.nodes.size(); ++i) {
     const ExplicitNode& n = h.nodes[i];
@@ -26,6 +27,7 @@ void build_wide(ExplicitHierarchy& h) {
     hd.first = n.first;
     hd.count = n.count;
     hd.leaf = n.leaf ? kWideLeaf : kWideInterior;
+    hd.lanes = n.leaf ? 0 : static_cast<std::uint8_t>((1u << std::min<int>(n.count, 8)) - 1u);
     hd.block = static_cast<std::uint32_t>(w.blocks.size());
     if (n.leaf) {
       bool triangles = n.count > 0;
@@ -58,6 +60,9 @@ void build_wide(ExplicitHierarchy& h) {
       w.blocks.push_back(b);
     }
   }
+  // One spare block: the AVX2 walk tests a node of up to 4 children with the 8-lane kernel
+  // too, reading the block after its own (lanes masked off by WideHeader::lanes).
+  w.blocks.emplace_back();
 }
 
 }  // namespace amalgam

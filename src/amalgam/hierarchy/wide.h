@@ -33,11 +33,16 @@ struct WideHeader {
   std::uint32_t block = 0;
   std::uint16_t count = 0;
   std::uint8_t leaf = kWideInterior;
+  /// Interior nodes: the bit mask of the first min(count, 8) lanes, (1 << that) - 1, so that
+  /// the traversal masks off a block's unused lanes with one load.
+  std::uint8_t lanes = 0;
 };
 
 struct WideNodes {
   std::vector<WideHeader> headers;  ///< one per node
-  std::vector<WideBox4> blocks;     ///< children's boxes of every interior node
+  /// Children's boxes of every interior node, and one spare block at the end (an 8-lane read
+  /// of the last node's single block stays inside the vector).
+  std::vector<WideBox4> blocks;
   std::vector<TrianglePack4> tris;  ///< triangles of every triangle-only leaf, leaf order
   std::size_t bytes() const {
     return headers.size() * sizeof(WideHeader) + blocks.size() * sizeof(WideBox4) +

@@ -73,6 +73,7 @@ class WideWalk {
     // reloaded after every store to the stack (a float store may alias them).
     const WideRay wr = WideRay::of(s.ray);
     tri_ = wr.pre;  // for the primitives of mixed leaves (`primitive`)
+    const Arrays arr{w.headers.data(), w.blocks.data(), w.tris.data()};
     StackItem* st = stack_.data();
     std::size_t cap = stack_.size(), sp = 0;
     StackItem it = st[0];
@@ -88,7 +89,7 @@ class WideWalk {
           }
         }
       }
-      const Next next = !rendered ? expand<kRays>(s, w, wr, it, st, cap, sp)
+      const Next next = !rendered ? expand<kRays>(s, arr, wr, it, st, cap, sp)
                         : s.done  ? Next::kStop
                                   : Next::kPop;
       if (next == Next::kEnter) continue;
@@ -99,6 +100,14 @@ class WideWalk {
       } while (it.t > s.ray.tmax);
     }
   }
+
+  /// The node arrays' bases as the loop's locals (read through `WideNodes`, they were loaded
+  /// again at every node: a store to the stack may alias them).
+  struct Arrays {
+    const WideHeader* headers;
+    const WideBox4* blocks;
+    const TrianglePack4* tris;
+  };
 
   /// What the walk does after a node: enter `it` (the nearest hit child), pop the stack, or
   /// stop (the ray is done: a shadow ray occluded). `done` is read only where it can have
@@ -111,13 +120,13 @@ class WideWalk {
   /// 2 133 instructions per ray; docs/benchmarks.md). kEnter: `it` is now the nearest hit
   /// child, to be entered next (the other hit children are on the stack).
   template <BoxRays kRays>
-  [[gnu::always_inline]] Next expand(State& s, const WideNodes& w, const WideRay& wr, StackItem& it,
+  [[gnu::always_inline]] Next expand(State& s, const Arrays& w, const WideRay& wr, StackItem& it,
                                      StackItem*& st, std::size_t& cap, std::size_t& sp) {
     const WideHeader hd = w.headers[it.node];
     const int cl = it.level + 1;
     const int count = hd.count;
     if (hd.leaf == kWideTriangleLeaf) {
-      leaf_triangles(s, w, wr, hd, cl);
+      leaf_triangles(s, w.tris + hd.block, wr, hd.first, count, cl);
       return s.done ? Next::kStop : Next::kPop;
     }
     if (hd.leaf == kWideLeaf) {
@@ -130,7 +139,7 @@ class WideWalk {
     }
     const ObjectKind ok = s.object_kind(cl);
     for (int i = 0; i < count; ++i) s.counters.count_test(s.kind, ok, cl);
-    const WideBox4* blk = w.blocks.data() + hd.block;
+    const WideBox4* blk = w.blocks + hd.block;
     // One kernel call for the whole node (arity <= 8 with AVX2, <= 4 otherwise): a single hit
     // child is entered at once, without touching the stack.
 #if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
@@ -140,7 +149,10 @@ class WideWalk {
 #endif
     if (count <= kOneCall) {
       alignas(32) float t[kOneCall];
-      const unsigned mask = boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, count, t);
+      // The kernel tests all lanes of kOneCall / 4 blocks (a node of up to 4 children reads
+      // the block after its own too: no branch on the count, and WideNodes keeps a spare block
+      // at the end); the header's mask keeps the children's lanes.
+      const unsigned mask = boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, kOneCall, t) & hd.lanes;
       if (mask == 0) return Next::kPop;
       const int l0 = std::countr_zero(mask);
       const unsigned rest = mask & (mask - 1);
@@ -227,16 +239,21 @@ class WideWalk {
   /// against the same tmax) a lane is taken in leaf order when its t is still <= tmax (ties:
   /// the later one, as there); a shadow ray stops at the first hit in leaf order, having tested
   /// the triangles up to and including it.
-  static void leaf_triangles(State& s, const WideNodes& w, const WideRay& wr, const WideHeader& hd,
-                             int level) {
-    const TrianglePack4* pack = w.tris.data() + hd.block;
-    const int count = hd.count;
+  [[gnu::always_inline]] static void leaf_triangles(State& s, const TrianglePack4* pack,
+                                                    const WideRay& wr, std::uint32_t first,
+                                                    int count, int level) {
+    if (count <= kWideLanes) {  // one pack (the default leaves): no loop to set up
+      TrianglePackHits c;
+      take(s, first, level, 0, count, triangle_test4(*pack, wr, s.ray.tmin, s.ray.tmax, count, c),
+           c);
+      return;
+    }
     int c0 = 0;
 #if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
     for (; count - c0 > kWideLanes; c0 += 2 * kWideLanes, pack += 2) {
       TrianglePackHitsN<2 * kWideLanes> c;
       const int m = std::min(count - c0, 2 * kWideLanes);
-      if (!take(s, hd, level, c0, m,
+      if (!take(s, first, level, c0, m,
                 triangle_test_lanes<Lanes8>(pack, wr, s.ray.tmin, s.ray.tmax, m, c), c))
         return;
     }
@@ -244,7 +261,7 @@ class WideWalk {
     for (; c0 < count; c0 += kWideLanes, ++pack) {
       TrianglePackHits c;
       const int m = std::min(count - c0, kWideLanes);
-      if (!take(s, hd, level, c0, m, triangle_test4(*pack, wr, s.ray.tmin, s.ray.tmax, m, c), c))
+      if (!take(s, first, level, c0, m, triangle_test4(*pack, wr, s.ray.tmin, s.ray.tmax, m, c), c))
         return;
     }
   }
@@ -253,7 +270,7 @@ class WideWalk {
   /// takes the hits as the one-by-one loop would. False when the ray is done (a shadow ray
   /// occluded).
   template <class Hits>
-  [[gnu::always_inline]] static bool take(State& s, const WideHeader& hd, int level, int c0, int m,
+  [[gnu::always_inline]] static bool take(State& s, std::uint32_t first, int level, int c0, int m,
                                           unsigned mask, const Hits& c) {
     if (s.any_hit && mask) {
       const int tested = std::countr_zero(mask) + 1;
@@ -265,7 +282,7 @@ class WideWalk {
     for (; mask; mask &= mask - 1) {
       const int lane = std::countr_zero(mask);
       if (!(c.t[lane] <= s.ray.tmax)) continue;  // an earlier lane hit closer
-      s.on_triangle(hd.first + static_cast<std::uint32_t>(c0 + lane), level, c.lane(lane));
+      s.on_triangle(first + static_cast<std::uint32_t>(c0 + lane), level, c.lane(lane));
     }
     return true;
   }
