@@ -138,7 +138,7 @@ class WideWalk {
       return Next::kPop;
     }
     const ObjectKind ok = s.object_kind(cl);
-    for (int i = 0; i < count; ++i) s.counters.count_test(s.kind, ok, cl);
+    s.counters.count_tests(s.kind, ok, cl, static_cast<std::uint64_t>(count));
     const WideBox4* blk = w.blocks + hd.block;
     // One kernel call for the whole node (arity <= 8 with AVX2, <= 4 otherwise): a single hit
     // child is entered at once, without touching the stack.
@@ -274,11 +274,12 @@ class WideWalk {
                                           unsigned mask, const Hits& c) {
     if (s.any_hit && mask) {
       const int tested = std::countr_zero(mask) + 1;
-      for (int i = 0; i < tested; ++i) s.counters.count_test(s.kind, ObjectKind::kPrimitive, level);
+      s.counters.count_tests(s.kind, ObjectKind::kPrimitive, level,
+                             static_cast<std::uint64_t>(tested));
       s.occlude();
       return false;
     }
-    for (int i = 0; i < m; ++i) s.counters.count_test(s.kind, ObjectKind::kPrimitive, level);
+    s.counters.count_tests(s.kind, ObjectKind::kPrimitive, level, static_cast<std::uint64_t>(m));
     for (; mask; mask &= mask - 1) {
       const int lane = std::countr_zero(mask);
       if (!(c.t[lane] <= s.ray.tmax)) continue;  // an earlier lane hit closer
