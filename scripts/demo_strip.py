@@ -23,17 +23,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.colors import BoundaryNorm, LogNorm  # noqa: E402
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import pfm  # noqa: E402
+
 
 def read_pfm(path):
     """A PFM image as a float32 array (rows from the top), one channel if it is grey."""
-    with open(path, "rb") as f:
-        kind = f.readline().strip()
-        width, height = (int(v) for v in f.readline().split())
-        scale = float(f.readline())
-        channels = 3 if kind == b"PF" else 1
-        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
-    img = data.reshape(height, width, channels)[::-1]
-    return img[:, :, 0] if channels == 3 and np.all(img[:, :, 0] == img[:, :, 1]) else img
+    img = pfm.read_pfm(path)
+    return img[:, :, 0] if img.shape[2] == 3 and np.all(img[:, :, 0] == img[:, :, 1]) else img
 
 
 def main():

@@ -36,16 +36,16 @@ import tempfile
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import pfm  # noqa: E402
+
 
 def read_pfm(path):
-    with open(path, "rb") as f:
-        kind = f.readline().strip()
-        if kind != b"PF":
-            sys.exit(f"{path}: not a colour PFM")
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
-    return data.reshape(h, w, 3)[::-1].astype(np.float64)  # PFM rows run bottom to top
+    """A colour PFM as an H x W x 3 float64 array, top row first."""
+    img = pfm.read_pfm(path)
+    if img.shape[2] != 3:
+        sys.exit(f"{path}: not a colour PFM")
+    return img.astype(np.float64)
 
 
 def disc_blur(img, diameter):

@@ -29,10 +29,7 @@ struct Counters {
   /// them in order. `tests` is unchanged by it.
   std::array<std::uint64_t, 2> reached{};
 
-  void count_test(RayKind r, ObjectKind o, int level) {
-    ++tests[static_cast<int>(r)][static_cast<int>(o)];
-    ++by_level[static_cast<unsigned>(level) < kCountedLevels ? level : kCountedLevels - 1];
-  }
+  void count_test(RayKind r, ObjectKind o, int level) { count_tests(r, o, level, 1); }
   /// `n` tests of one kind on one level at once (a node's children tested together): the
   /// same counts as n calls of count_test, in two additions.
   void count_tests(RayKind r, ObjectKind o, int level, std::uint64_t n) {

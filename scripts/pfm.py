@@ -1,0 +1,17 @@
+"""Reading PFM images (what `amalgam render --out X.pfm` writes) with NumPy."""
+
+import numpy as np
+
+
+def read_pfm(path):
+    """A PFM image ("PF" colour or "Pf" grey) as an H x W x C float32 array, top row first
+    (PFM stores its rows bottom to top). Exits with one line naming the file if it is not one."""
+    with open(path, "rb") as f:
+        kind = f.readline().strip()
+        if kind not in (b"PF", b"Pf"):
+            raise SystemExit(f"{path}: not a PFM image")
+        width, height = (int(v) for v in f.readline().split())
+        scale = float(f.readline())
+        channels = 3 if kind == b"PF" else 1
+        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
+    return data.reshape(height, width, channels)[::-1]
