@@ -193,25 +193,27 @@ enum class BoxRays { kZeroAxes, kNonZero };
 /// is applied once to the minimum over the axes instead of to each axis: x -> x * (1 + 2
 /// gamma(3)) rounded is non-decreasing and maps only zeros to zero, so the minimum of the
 /// products and the product of the minimum are the same float (a NaN is skipped either way).
+///
+/// `box_test_vectors` is the same test on boxes already in registers (`lo[axis]`, `hi[axis]`:
+/// the instanced walk's world boxes, computed per visit).
 template <class L, BoxRays kRays>
-inline unsigned box_test_lanes(const WideBox4* b, const WideRay& r, float tmin, float tmax, int n,
-                               float* t_entry) {
+[[gnu::always_inline]] inline unsigned box_test_vectors(const typename L::V lo[3],
+                                                        const typename L::V hi[3], const WideRay& r,
+                                                        float tmin, float tmax, int n,
+                                                        float* t_entry) {
   using V = typename L::V;
   constexpr float kGrow = 1.0f + 2.0f * gamma(3);
-  constexpr std::uint32_t kLo = 0, kHi = 3 * kWideLanes * sizeof(float);
   V t_near = L::set1(-kInfinity), t_far = L::set1(kInfinity);
   V ok = L::all();
   for (int a = 0; a < 3; ++a) {
     const V o = L::origin(r, a);
-    const std::uint32_t axis = static_cast<std::uint32_t>(a * kWideLanes * sizeof(float));
-    const V lo = L::load(b, kLo + axis), hi = L::load(b, kHi + axis);
     if (kRays == BoxRays::kZeroAxes && r.zero[a]) {  // scalar: if (o < lo || o > hi) miss
-      ok = L::band(ok, L::band(L::nlt(o, lo), L::ngt(o, hi)));
+      ok = L::band(ok, L::band(L::nlt(o, lo[a]), L::ngt(o, hi[a])));
       continue;
     }
     const V inv = L::inv(r, a);
-    const V t0 = L::mul(L::sub(lo, o), inv);
-    const V t1 = L::mul(L::sub(hi, o), inv);
+    const V t0 = L::mul(L::sub(lo[a], o), inv);
+    const V t1 = L::mul(L::sub(hi[a], o), inv);
     // scalar: if (t0 > t1) swap. minps(x, y) = x < y ? x : y; maxps(x, y) = x > y ? x : y.
     const V tn = L::min(t1, t0);
     const V tf = L::max(t0, t1);
@@ -225,6 +227,19 @@ inline unsigned box_test_lanes(const WideBox4* b, const WideRay& r, float tmin, 
   ok = L::band(ok, L::le(s0, s1));
   L::store(t_entry, s0);
   return L::mask(ok) & ((1u << n) - 1u);
+}
+
+template <class L, BoxRays kRays>
+inline unsigned box_test_lanes(const WideBox4* b, const WideRay& r, float tmin, float tmax, int n,
+                               float* t_entry) {
+  using V = typename L::V;
+  constexpr std::uint32_t kLo = 0, kHi = 3 * kWideLanes * sizeof(float);
+  V lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    const std::uint32_t axis = static_cast<std::uint32_t>(a * kWideLanes * sizeof(float));
+    lo[a] = L::load(b, kLo + axis), hi[a] = L::load(b, kHi + axis);
+  }
+  return box_test_vectors<L, kRays>(lo, hi, r, tmin, tmax, n, t_entry);
 }
 #endif
 

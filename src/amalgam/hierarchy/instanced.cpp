@@ -77,29 +77,30 @@ std::optional<SurfaceHit> InstancedHierarchy::intersect(PrimId p, const Ray& ray
   const InstanceData& in = instances[slot(p) - 1];
   const ExplicitHierarchy& mesh = meshes[in.mesh];
   if (in.identity) return mesh.intersect(local(p), ray);
-  // Object-space ray with the direction left unnormalised: t means the same in both spaces.
-  const Ray obj =
-      Ray::make(object_origin(in, ray.origin), in.to_object.vector(ray.dir), ray.tmin, ray.tmax);
-  auto hit = mesh.intersect(local(p), obj);
+  auto hit = mesh.intersect(local(p), object_ray(in, ray));
   if (!hit) return hit;
+  return world_hit(in, *hit, ray.dir);
+}
+
+SurfaceHit InstancedHierarchy::world_hit(const InstanceData& in, const SurfaceHit& h, Vec3 dir) {
   SurfaceHit w;
-  w.t = hit->t;
-  Vec3 n{dot(in.normal_rows[0], hit->normal), dot(in.normal_rows[1], hit->normal),
-         dot(in.normal_rows[2], hit->normal)};
+  w.t = h.t;
+  Vec3 n{dot(in.normal_rows[0], h.normal), dot(in.normal_rows[1], h.normal),
+         dot(in.normal_rows[2], h.normal)};
   n = normalize(n);
-  if (dot(n, ray.dir) > 0.0f) n = -n;
+  if (dot(n, dir) > 0.0f) n = -n;
   w.normal = n;
-  w.p = in.to_world.point(hit->p);
+  w.p = in.to_world.point(h.p);
   // Error of the transformed point (pbrt 3, section 3.9.4): the transformed error bound plus
   // the rounding of the transform itself.
-  const Vec3 ap = abs(hit->p);
+  const Vec3 ap = abs(h.p);
   Vec3 err;
   for (int i = 0; i < 3; ++i) {
-    err[i] = (gamma(3) + 1.0f) * dot(in.abs_rows[i], hit->p_error) +
+    err[i] = (gamma(3) + 1.0f) * dot(in.abs_rows[i], h.p_error) +
              gamma(3) * (dot(in.abs_rows[i], ap) + std::fabs(in.to_world.m[i][3]));
   }
   w.p_error = err + retransform_error(in, w.p, err);
-  w.b1 = hit->b1, w.b2 = hit->b2;  // an affine map keeps barycentrics
+  w.b1 = h.b1, w.b2 = h.b2;  // an affine map keeps barycentrics
   return w;
 }
 

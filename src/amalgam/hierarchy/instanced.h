@@ -43,6 +43,12 @@ class InstancedHierarchy {
   std::vector<ExplicitHierarchy> meshes;
   std::vector<InstanceData> instances;
   int levels = 0;
+  /// The top tree as the SIMD traversal reads it (hierarchy/wide.h), built by `build_wide`
+  /// after the bake. An interior top node's blocks hold its children's boxes; a top leaf's
+  /// header has `leaf == kWideLeaf` and its blocks hold the world boxes of its instances
+  /// (`top_items[first .. +count)`). Inside an instance the traversal reads the mesh's own
+  /// `WideNodes` and transforms the boxes per visit.
+  WideNodes top_wide;
 
   static constexpr std::uint64_t id(std::uint64_t instance_plus_one, std::uint32_t local) {
     return (instance_plus_one << 32) | local;
@@ -84,6 +90,11 @@ class InstancedHierarchy {
     return meshes[instances[slot(p) - 1].mesh].surface_at(local(p), s);
   }
   HierarchyInfo info() const;
+  /// The top tree's SIMD form when `build_wide` has built it (and with it every mesh's), else
+  /// null: the traversal's generic path.
+  const WideNodes* top_wide_nodes() const {
+    return !top_nodes.empty() && top_wide.headers.size() == top_nodes.size() ? &top_wide : nullptr;
+  }
   /// The primitive in world space (for flatten() and tests).
   Primitive primitive(PrimId p) const;
 
@@ -100,95 +111,22 @@ class InstancedHierarchy {
   /// 1e-5 m 100 m out, as much as a subdivided Wuson's triangles are from a ray's silhouette).
   static Vec3 object_origin(const InstanceData& in, Vec3 o);
 
+  /// World ray `r` in the object space of instance `in` (not an identity), the direction left
+  /// unnormalised so that t means the same in both spaces; what every primitive test inside
+  /// the instance uses.
+  static Ray object_ray(const InstanceData& in, const Ray& r) {
+    return Ray::make(object_origin(in, r.origin), in.to_object.vector(r.dir), r.tmin, r.tmax);
+  }
+
+  /// The world hit of instance `in` (not an identity) from its object-space hit `h` of a ray
+  /// with world direction `dir`: normal, point and error bound transformed.
+  static SurfaceHit world_hit(const InstanceData& in, const SurfaceHit& h, Vec3 dir);
+
   /// What `intersect` adds to the error bound `err` of a world hit point `p` of instance `in`:
   /// the error of taking the origin of a ray that leaves p (offset_ray_origin) back into object
   /// space in float, in world units, so that the offset keeps that origin in front of the
   /// surface in object space too (a shadow ray otherwise meets its own triangle again).
   static Vec3 retransform_error(const InstanceData& in, Vec3 p, Vec3 err);
-
-  /// The children of node `n` for the traversal's SIMD test (hierarchy/wide.h): top-level
-  /// nodes' and instance roots' world boxes as stored; inside an instance, the world box of
-  /// each child's transformed box, computed four at a time with the float operations of
-  /// `world_box` in the same order (bit-identical to it); for a leaf inside an instance, its
-  /// primitives' ids.
-  void gather_children(NodeId n, GatheredChildren& out) const {
-    const std::uint64_t s = slot(n);
-    if (s == 0) {
-      const ExplicitNode& t = top_nodes[n];
-      out.count = static_cast<int>(t.count);
-      out.primitives = false;
-      for (int i = 0; i < out.count; ++i) {
-        if (t.leaf) {
-          const std::uint32_t inst = top_items[t.first + static_cast<std::uint32_t>(i)];
-          out.ids[i] = id(inst + 1ull, 0);
-          out.put_box(i, instances[inst].world_bounds);
-        } else {
-          out.ids[i] = t.first + static_cast<std::uint32_t>(i);
-          out.put_box(i, top_nodes[t.first + static_cast<std::uint32_t>(i)].bounds);
-        }
-      }
-      return;
-    }
-    const InstanceData& in = instances[s - 1];
-    const ExplicitHierarchy& mesh = meshes[in.mesh];
-    const ExplicitNode& e = mesh.nodes[local(n)];
-    out.count = static_cast<int>(e.count);
-    out.primitives = e.leaf;
-    for (int i = 0; i < out.count; ++i) out.ids[i] = id(s, e.first + static_cast<std::uint32_t>(i));
-    if (e.leaf) return;
-    for (int i = 0; i < out.count; ++i)
-      out.put_box(i, mesh.nodes[e.first + static_cast<std::uint32_t>(i)].bounds);
-    if (!in.identity) {
-      for (int c0 = 0; c0 < out.count; c0 += kWideLanes)
-        world_boxes4(in, out.boxes[c0 / kWideLanes], std::min(out.count - c0, kWideLanes));
-    }
-  }
-
- private:
-  /// Replaces the first `n` object-space boxes of `w` by world_box of each (empty boxes stay
-  /// as they are, as there).
-  static void world_boxes4(const InstanceData& in, WideBox4& w, int n) {
-#if AMALGAM_WIDE_SSE
-    bool any_empty = false;
-    for (int l = 0; l < n; ++l)
-      any_empty |= w.lo[0][l] > w.hi[0][l] || w.lo[1][l] > w.hi[1][l] || w.lo[2][l] > w.hi[2][l];
-    if (!any_empty) {
-      const __m128 half = _mm_set1_ps(0.5f);
-      const __m128 sign = _mm_set1_ps(-0.0f);
-      const __m128 k = _mm_set1_ps(4.0f * gamma(3));
-      __m128 c[3], h[3];
-      for (int a = 0; a < 3; ++a) {
-        const __m128 lo = _mm_load_ps(w.lo[a]), hi = _mm_load_ps(w.hi[a]);
-        c[a] = _mm_mul_ps(_mm_add_ps(lo, hi), half);  // Bbox::center
-        h[a] = _mm_mul_ps(_mm_sub_ps(hi, lo), half);  // Bbox::extent() * 0.5f
-      }
-      for (int r = 0; r < 3; ++r) {
-        const float* m = in.to_world.m[r];
-        // Transform::point: ((m0 x + m1 y) + m2 z) + m3.
-        __m128 cw = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(m[0]), c[0]),
-                                                     _mm_mul_ps(_mm_set1_ps(m[1]), c[1])),
-                                          _mm_mul_ps(_mm_set1_ps(m[2]), c[2])),
-                               _mm_set1_ps(m[3]));
-        // dot(abs_rows[r], h): (x + y) + z.
-        const Vec3 ar = in.abs_rows[r];
-        __m128 rw = _mm_add_ps(
-            _mm_add_ps(_mm_mul_ps(_mm_set1_ps(ar.x), h[0]), _mm_mul_ps(_mm_set1_ps(ar.y), h[1])),
-            _mm_mul_ps(_mm_set1_ps(ar.z), h[2]));
-        // r += (|c| + r) * 4 gamma(3)
-        rw = _mm_add_ps(rw, _mm_mul_ps(_mm_add_ps(_mm_andnot_ps(sign, cw), rw), k));
-        _mm_store_ps(w.lo[r], _mm_sub_ps(cw, rw));
-        _mm_store_ps(w.hi[r], _mm_add_ps(cw, rw));
-      }
-      return;
-    }
-#endif
-    for (int l = 0; l < n; ++l) {
-      const Bbox b = world_box(
-          in, Bbox{{w.lo[0][l], w.lo[1][l], w.lo[2][l]}, {w.hi[0][l], w.hi[1][l], w.hi[2][l]}});
-      w.lo[0][l] = b.lo.x, w.lo[1][l] = b.lo.y, w.lo[2][l] = b.lo.z;
-      w.hi[0][l] = b.hi.x, w.hi[1][l] = b.hi.y, w.hi[2][l] = b.hi.z;
-    }
-  }
 };
 
 }  // namespace amalgam

@@ -17,6 +17,7 @@
 namespace amalgam {
 
 class ExplicitHierarchy;
+class InstancedHierarchy;
 
 /// WideHeader::leaf values.
 enum : std::uint8_t {
@@ -50,32 +51,11 @@ struct WideNodes {
   }
 };
 
-/// The children of one node gathered for a SIMD test, as a hierarchy that is not stored in
-/// `WideNodes` form hands them to the traversal (`gather_children`, e.g. the instanced form,
-/// whose boxes inside an instance are computed per visit): their boxes in SoA blocks of four and
-/// their ids; for a leaf, only the ids of its primitives (in stored order).
-struct GatheredChildren {
-  WideBox4 boxes[kMaxChildren / kWideLanes];
-  NodeId ids[kMaxChildren];
-  int count = 0;
-  bool primitives = false;
-
-  /// Stores `b` as child `i`'s box.
-  void put_box(int i, const Bbox& b) {
-    WideBox4& w = boxes[i / kWideLanes];
-    const int l = i % kWideLanes;
-    w.lo[0][l] = b.lo.x, w.lo[1][l] = b.lo.y, w.lo[2][l] = b.lo.z;
-    w.hi[0][l] = b.hi.x, w.hi[1][l] = b.hi.y, w.hi[2][l] = b.hi.z;
-  }
-  /// Child `i`'s box.
-  Bbox box(int i) const {
-    const WideBox4& w = boxes[i / kWideLanes];
-    const int l = i % kWideLanes;
-    return {{w.lo[0][l], w.lo[1][l], w.lo[2][l]}, {w.hi[0][l], w.hi[1][l], w.hi[2][l]}};
-  }
-};
-
 /// (Re)builds `h.wide` from `h.nodes`.
 void build_wide(ExplicitHierarchy& h);
+
+/// (Re)builds `h.top_wide` from `h.top_nodes`, and the `WideNodes` of every mesh that has none
+/// (called at the end of `build_instanced`).
+void build_wide(InstancedHierarchy& h);
 
 }  // namespace amalgam

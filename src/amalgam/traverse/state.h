@@ -1,7 +1,7 @@
 #pragma once
 /// \file The state every traversal algorithm shares while it traces one ray, and the rules
 /// applied when a ray meets a primitive or renders an amalgam, written once for all of them
-/// (generic_walk.h, wide_walk.h, gathered_walk.h, and the scalar reference, reference.h).
+/// (generic_walk.h, wide_walk.h, instanced_walk.h, and the scalar reference, reference.h).
 ///
 /// Cost accounting follows the paper: every bounding volume, amalgam and primitive a ray is
 /// tested against counts once, on the level of the object tested (root = level 0); a node is

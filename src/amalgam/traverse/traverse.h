@@ -6,16 +6,16 @@
 /// It picks one algorithm per hierarchy, all sharing one ray state and its rules (state.h):
 /// - a hierarchy with SoA child boxes (ExplicitHierarchy, `wide_nodes()`), sorted order:
 ///   wide_walk.h, iterative, a node's children tested at once with SIMD;
-/// - a hierarchy that gathers a node's children (InstancedHierarchy, `gather_children`),
-///   sorted order: gathered_walk.h;
+/// - the two-level instanced hierarchy (`top_wide_nodes()`), sorted order: instanced_walk.h,
+///   the same walk over the top tree and each instance's mesh;
 /// - otherwise (the builtin implicit scenes; stored order): generic_walk.h, recursive.
 /// The scalar reference, reference.h, gives the same hits and counts for every combination
 /// (tests/traverse/simd_test.cpp).
 
 #include <vector>
 
-#include "amalgam/traverse/gathered_walk.h"
 #include "amalgam/traverse/generic_walk.h"
+#include "amalgam/traverse/instanced_walk.h"
 #include "amalgam/traverse/order.h"
 #include "amalgam/traverse/wide_walk.h"
 
@@ -43,6 +43,8 @@ class Traversal {
     run();
     if constexpr (kWide) {
       if (s_.pending) WideWalk<State>::finish(s_);
+    } else if constexpr (kInstanced) {
+      if (s_.pending) InstancedWalk<State>::finish(s_);
     }
     if (translucent) {
       const float t_hit = s_.hit.t;
@@ -62,7 +64,7 @@ class Traversal {
  private:
   static constexpr bool kSorted = Order::kSorted;
   static constexpr bool kWide = WideHierarchy<H> && kSorted;
-  static constexpr bool kGathered = GatheringHierarchy<H> && kSorted;
+  static constexpr bool kInstanced = InstancedWideHierarchy<H> && kSorted;
 
   void run() {
     const NodeId root = s_.h.root();
@@ -76,9 +78,11 @@ class Traversal {
         return;
       }
     }
-    if constexpr (kGathered) {
-      gathered_.run(s_, root, t0);
-      return;
+    if constexpr (kInstanced) {
+      if (const WideNodes* w = s_.h.top_wide_nodes()) {
+        instanced_.run(s_, *w, t0);
+        return;
+      }
     }
     GenericWalk<State, kSorted>::enter(s_, root, 0, b, t0);
   }
@@ -86,7 +90,7 @@ class Traversal {
   struct None {};
   State s_;
   [[no_unique_address]] std::conditional_t<kWide, WideWalk<State>, None> wide_;
-  [[no_unique_address]] std::conditional_t<kGathered, GatheredWalk<State>, None> gathered_;
+  [[no_unique_address]] std::conditional_t<kInstanced, InstancedWalk<State>, None> instanced_;
 };
 
 AMALGAM_ISA_END

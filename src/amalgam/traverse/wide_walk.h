@@ -30,6 +30,66 @@ concept WideHierarchy = requires(const H& h, std::size_t i) {
 
 AMALGAM_ISA_BEGIN
 
+/// The triangles of a triangle-only leaf, tested from their SoA packs against the ray `wr`
+/// (the ray in the leaf's own space: the instanced walk passes the object-space ray) over
+/// the state's [tmin, tmax]: shared by the explicit and the instanced walk.
+template <class State>
+struct PackLeaf {
+  /// A triangle-only leaf (primitives `first` ..), four triangles at a time (`triangle_test4`;
+  /// eight, from two packs, in the AVX2 copy), with the results and counts of the one-by-one loop:
+  /// there, a triangle is tested against the tmax left by the hits before it, so of the lanes hit
+  /// (all tested against the same tmax) a lane is taken in leaf order when its t is still <= tmax
+  /// (ties: the later one, as there); a shadow ray stops at the first hit in leaf order, having
+  /// tested the triangles up to and including it.
+  [[gnu::always_inline]] static void test(State& s, const TrianglePack4* pack, const WideRay& wr,
+                                          PrimId first, int count, int level) {
+    if (count <= kWideLanes) {  // one pack (the default leaves): no loop to set up
+      TrianglePackHits c;
+      take(s, first, level, 0, count, triangle_test4(*pack, wr, s.ray.tmin, s.ray.tmax, count, c),
+           c);
+      return;
+    }
+    int c0 = 0;
+#if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
+    for (; count - c0 > kWideLanes; c0 += 2 * kWideLanes, pack += 2) {
+      TrianglePackHitsN<2 * kWideLanes> c;
+      const int m = std::min(count - c0, 2 * kWideLanes);
+      if (!take(s, first, level, c0, m,
+                triangle_test_lanes<Lanes8>(pack, wr, s.ray.tmin, s.ray.tmax, m, c), c))
+        return;
+    }
+#endif
+    for (; c0 < count; c0 += kWideLanes, ++pack) {
+      TrianglePackHits c;
+      const int m = std::min(count - c0, kWideLanes);
+      if (!take(s, first, level, c0, m, triangle_test4(*pack, wr, s.ray.tmin, s.ray.tmax, m, c), c))
+        return;
+    }
+  }
+
+  /// The lanes `mask` of a pack test of `m` triangles from `c0` of the leaf: counts them and
+  /// takes the hits as the one-by-one loop would. False when the ray is done (a shadow ray
+  /// occluded).
+  template <class Hits>
+  [[gnu::always_inline]] static bool take(State& s, PrimId first, int level, int c0, int m,
+                                          unsigned mask, const Hits& c) {
+    if (s.any_hit && mask) {
+      const int tested = std::countr_zero(mask) + 1;
+      s.counters.count_tests(s.kind, ObjectKind::kPrimitive, level,
+                             static_cast<std::uint64_t>(tested));
+      s.occlude();
+      return false;
+    }
+    s.counters.count_tests(s.kind, ObjectKind::kPrimitive, level, static_cast<std::uint64_t>(m));
+    for (; mask; mask &= mask - 1) {
+      const int lane = std::countr_zero(mask);
+      if (!(c.t[lane] <= s.ray.tmax)) continue;  // an earlier lane hit closer
+      s.on_triangle(first + static_cast<PrimId>(c0 + lane), level, c.lane(lane));
+    }
+    return true;
+  }
+};
+
 template <class State>
 class WideWalk {
  public:
@@ -126,7 +186,7 @@ class WideWalk {
     const int cl = it.level + 1;
     const int count = hd.count;
     if (hd.leaf == kWideTriangleLeaf) {
-      leaf_triangles(s, w.tris + hd.block, wr, hd.first, count, cl);
+      PackLeaf<State>::test(s, w.tris + hd.block, wr, hd.first, count, cl);
       return s.done ? Next::kStop : Next::kPop;
     }
     if (hd.leaf == kWideLeaf) {
@@ -231,61 +291,6 @@ class WideWalk {
       while (i > base && st[i - 1].t <= te) st[i] = st[i - 1], --i;
       st[i] = {te, first + static_cast<std::uint32_t>(lane), level};
     }
-  }
-
-  /// A triangle-only leaf, four triangles at a time (`triangle_test4`; eight, from two packs,
-  /// in the AVX2 copy), with the results and counts of the one-by-one loop: there, a triangle
-  /// is tested against the tmax left by the hits before it, so of the lanes hit (all tested
-  /// against the same tmax) a lane is taken in leaf order when its t is still <= tmax (ties:
-  /// the later one, as there); a shadow ray stops at the first hit in leaf order, having tested
-  /// the triangles up to and including it.
-  [[gnu::always_inline]] static void leaf_triangles(State& s, const TrianglePack4* pack,
-                                                    const WideRay& wr, std::uint32_t first,
-                                                    int count, int level) {
-    if (count <= kWideLanes) {  // one pack (the default leaves): no loop to set up
-      TrianglePackHits c;
-      take(s, first, level, 0, count, triangle_test4(*pack, wr, s.ray.tmin, s.ray.tmax, count, c),
-           c);
-      return;
-    }
-    int c0 = 0;
-#if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
-    for (; count - c0 > kWideLanes; c0 += 2 * kWideLanes, pack += 2) {
-      TrianglePackHitsN<2 * kWideLanes> c;
-      const int m = std::min(count - c0, 2 * kWideLanes);
-      if (!take(s, first, level, c0, m,
-                triangle_test_lanes<Lanes8>(pack, wr, s.ray.tmin, s.ray.tmax, m, c), c))
-        return;
-    }
-#endif
-    for (; c0 < count; c0 += kWideLanes, ++pack) {
-      TrianglePackHits c;
-      const int m = std::min(count - c0, kWideLanes);
-      if (!take(s, first, level, c0, m, triangle_test4(*pack, wr, s.ray.tmin, s.ray.tmax, m, c), c))
-        return;
-    }
-  }
-
-  /// The lanes `mask` of a pack test of `m` triangles from `c0` of the leaf: counts them and
-  /// takes the hits as the one-by-one loop would. False when the ray is done (a shadow ray
-  /// occluded).
-  template <class Hits>
-  [[gnu::always_inline]] static bool take(State& s, std::uint32_t first, int level, int c0, int m,
-                                          unsigned mask, const Hits& c) {
-    if (s.any_hit && mask) {
-      const int tested = std::countr_zero(mask) + 1;
-      s.counters.count_tests(s.kind, ObjectKind::kPrimitive, level,
-                             static_cast<std::uint64_t>(tested));
-      s.occlude();
-      return false;
-    }
-    s.counters.count_tests(s.kind, ObjectKind::kPrimitive, level, static_cast<std::uint64_t>(m));
-    for (; mask; mask &= mask - 1) {
-      const int lane = std::countr_zero(mask);
-      if (!(c.t[lane] <= s.ray.tmax)) continue;  // an earlier lane hit closer
-      s.on_triangle(first + static_cast<std::uint32_t>(c0 + lane), level, c.lane(lane));
-    }
-    return true;
   }
 
   /// One primitive of a mixed leaf: triangles with the per-ray setup and a deferred

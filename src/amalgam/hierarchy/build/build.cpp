@@ -114,6 +114,7 @@ InstancedHierarchy build_instanced(std::vector<ExplicitHierarchy> meshes,
   BakeConfig bc = config.bake;
   bc.parallel = bc.parallel && config.parallel;
   timed_bake(h, bc, config.bake_seconds);
+  build_wide(h);
   return h;
 }
 

@@ -1,0 +1,311 @@
+#pragma once
+/// \file The fast traversal of the two-level instanced hierarchy (sorted order): the walk of
+/// wide_walk.h over the top tree's SoA blocks (`InstancedHierarchy::top_wide`) and, inside an
+/// instance, over its mesh's own `WideNodes`, shared by every instance of the mesh.
+///
+/// The ray stays in world space. A node inside an instance has as children's boxes the world
+/// boxes of their transformed boxes (`InstancedHierarchy::world_box`), computed at each visit
+/// for the whole node at once (eight lanes in the AVX2 copy) with world_box's float operations
+/// in its order, so the boxes, entries, order and counts are the generic walk's
+/// (tests/traverse/simd_test.cpp compares them with the scalar reference). A leaf's triangles
+/// are tested from the mesh's packs against the ray taken into the instance's object space
+/// once per instance entered (the generic path takes it there again for every triangle), and
+/// the SurfaceHit of the closest hit is built once, at the end (`finish`).
+
+#include <algorithm>
+#include <bit>
+#include <concepts>
+#include <vector>
+
+#include "amalgam/geometry/wide_kernels.h"
+#include "amalgam/hierarchy/instanced.h"
+#include "amalgam/hierarchy/wide.h"
+#include "amalgam/traverse/state.h"
+#include "amalgam/traverse/wide_walk.h"
+
+namespace amalgam {
+
+/// A two-level hierarchy whose top tree and meshes are in SIMD form (`top_wide_nodes()` is
+/// null when they are not built).
+template <class H>
+concept InstancedWideHierarchy = requires(const H& h) {
+  { h.top_wide_nodes() } -> std::same_as<const WideNodes*>;
+};
+
+AMALGAM_ISA_BEGIN
+
+template <class State>
+class InstancedWalk {
+  using IH = InstancedHierarchy;
+
+ public:
+  /// Traces `s.ray` from the root (its box met at `t_root`).
+  void run(State& s, const WideNodes& top, float t_root) {
+    if (stack_.size() < 64) stack_.resize(64);
+    obj_inst_ = 0;
+    const bool zero = s.ray.dir.x == 0.0f || s.ray.dir.y == 0.0f || s.ray.dir.z == 0.0f;
+    if (zero)
+      loop<BoxRays::kZeroAxes>(s, top, t_root);
+    else
+      loop<BoxRays::kNonZero>(s, top, t_root);
+  }
+
+  /// Builds the SurfaceHit of the closest hit when it is a deferred triangle: the generic
+  /// path's `InstancedHierarchy::intersect` for that triangle, bit for bit.
+  static void finish(State& s) {
+    const IH& h = s.h;
+    const IH::InstanceData& in = h.instances[IH::slot(s.hit.id) - 1];
+    const Primitive& p = h.meshes[in.mesh].prims[IH::local(s.hit.id)];
+    if (in.identity) {
+      s.hit.surf = triangle_finish(s.ray, p.a, p.b, p.c, s.cand);
+    } else {
+      const Ray obj = IH::object_ray(in, s.ray);
+      s.hit.surf = IH::world_hit(in, triangle_finish(obj, p.a, p.b, p.c, s.cand), s.ray.dir);
+    }
+    s.pending = false;
+  }
+
+ private:
+  struct StackItem {
+    float t;
+    std::uint32_t node;  ///< in the top tree (inst 0) or in the instance's mesh
+    std::uint32_t inst;  ///< 0: the top tree; else instance index + 1 (IH::slot)
+    int level;
+  };
+
+  enum class Next { kEnter, kPop, kStop };  ///< as in WideWalk
+
+#if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
+  static constexpr int kChunk = 2 * kWideLanes;  ///< children per kernel call
+#else
+  static constexpr int kChunk = kWideLanes;
+#endif
+
+  template <BoxRays kRays>
+  void loop(State& s, const WideNodes& top, float t_root) {
+    const WideRay wr = WideRay::of(s.ray);
+    StackItem* st = stack_.data();
+    std::size_t cap = stack_.size(), sp = 0;
+    StackItem it{t_root, 0, 0, 0};
+    for (;;) {
+      s.counters.count_reached(s.kind);
+      bool rendered = false;
+      if constexpr (State::kMayRender) {
+        if (s.lod.may_render(it.level)) {
+          const NodeId id = IH::id(it.inst, it.node);
+          const Bbox b = s.h.bounds(id);
+          if (s.renders(b, it.level, it.t)) {
+            s.render_amalgam(id, it.level, b, it.t);
+            rendered = true;
+          }
+        }
+      }
+      Next next;
+      if (rendered)
+        next = s.done ? Next::kStop : Next::kPop;
+      else if (it.inst == 0)
+        next = top_node<kRays>(s, top, wr, it, st, cap, sp);
+      else
+        next = instance_node<kRays>(s, wr, it, st, cap, sp);
+      if (next == Next::kEnter) continue;
+      if (next == Next::kStop) return;
+      do {
+        if (sp == 0) return;
+        it = st[--sp];
+      } while (it.t > s.ray.tmax);
+    }
+  }
+
+  /// A top-level node: its children are top nodes or, for a leaf, instance roots.
+  template <BoxRays kRays>
+  Next top_node(State& s, const WideNodes& top, const WideRay& wr, StackItem& it, StackItem*& st,
+                std::size_t& cap, std::size_t& sp) {
+    const WideHeader hd = top.headers[it.node];
+    const int cl = it.level + 1;
+    s.counters.count_tests(s.kind, s.object_kind(cl), cl, static_cast<std::uint64_t>(hd.count));
+    const WideBox4* blk = top.blocks.data() + hd.block;
+    const std::uint32_t* items = s.h.top_items.data() + hd.first;
+    const bool instances = hd.leaf == kWideLeaf;
+    return children(
+        s, it, st, cap, sp, hd.count, cl,
+        [&](int c0, int m, float* t) {
+          return boxes<kRays>(blk + c0 / kWideLanes, wr, s.ray.tmin, s.ray.tmax, m, t);
+        },
+        [&](int c) {
+          return instances ? StackItem{0, 0, items[c] + 1u, cl}
+                           : StackItem{0, hd.first + static_cast<std::uint32_t>(c), 0, cl};
+        });
+  }
+
+  /// A node inside instance `it.inst`.
+  template <BoxRays kRays>
+  Next instance_node(State& s, const WideRay& wr, StackItem& it, StackItem*& st, std::size_t& cap,
+                     std::size_t& sp) {
+    const std::uint32_t inst = it.inst;
+    const IH::InstanceData& in = s.h.instances[inst - 1];
+    const WideNodes& w = s.h.meshes[in.mesh].wide;
+    const WideHeader hd = w.headers[it.node];
+    const int cl = it.level + 1;
+    const int count = hd.count;
+    if (hd.leaf == kWideTriangleLeaf) {
+      const WideRay& owr = in.identity ? wr : object_ray(s, in, inst);
+      PackLeaf<State>::test(s, w.tris.data() + hd.block, owr, IH::id(inst, hd.first), count, cl);
+      return s.done ? Next::kStop : Next::kPop;
+    }
+    if (hd.leaf == kWideLeaf) {  // spheres or boxes: the generic path's test
+      for (int i = 0; i < count; ++i) {
+        s.counters.count_test(s.kind, ObjectKind::kPrimitive, cl);
+        const PrimId id = IH::id(inst, hd.first + static_cast<std::uint32_t>(i));
+        if (auto hit = s.h.intersect(id, s.ray)) s.on_primitive(id, cl, *hit);
+        if (s.done) return Next::kStop;
+      }
+      return Next::kPop;
+    }
+    s.counters.count_tests(s.kind, s.object_kind(cl), cl, static_cast<std::uint64_t>(count));
+    const WideBox4* blk = w.blocks.data() + hd.block;
+    auto child = [&](int c) {
+      return StackItem{0, hd.first + static_cast<std::uint32_t>(c), inst, cl};
+    };
+    if (in.identity) {
+      return children(
+          s, it, st, cap, sp, count, cl,
+          [&](int c0, int m, float* t) {
+            return boxes<kRays>(blk + c0 / kWideLanes, wr, s.ray.tmin, s.ray.tmax, m, t);
+          },
+          child);
+    }
+    return children(
+        s, it, st, cap, sp, count, cl,
+        [&](int c0, int m, float* t) {
+          return world_boxes<kRays>(in, blk + c0 / kWideLanes, wr, s.ray.tmin, s.ray.tmax, m, t);
+        },
+        child);
+  }
+
+  /// The hit children of a node of `count` children on level `cl`, tested `kChunk` at a time
+  /// by `test(c0, m, t)` (the mask of the hit lanes among children c0 .. c0 + m, their
+  /// entries in t), pushed farthest first as WideWalk does (ties: stored order); `make(c)` is
+  /// child c's stack item (its t filled in here). kEnter with `it` the nearest hit child.
+  template <class Test, class Make>
+  [[gnu::always_inline]] Next children(State& s, StackItem& it, StackItem*& st, std::size_t& cap,
+                                       std::size_t& sp, int count, int cl, Test&& test,
+                                       Make&& make) {
+    (void)s, (void)cl;
+    if (sp + static_cast<std::size_t>(count) > cap) {
+      stack_.resize(2 * cap + static_cast<std::size_t>(count));
+      st = stack_.data(), cap = stack_.size();
+    }
+    const std::size_t base = sp;
+    for (int c0 = 0; c0 < count; c0 += kChunk) {
+      alignas(32) float t[kChunk];
+      for (unsigned mask = test(c0, std::min(count - c0, kChunk), t); mask; mask &= mask - 1) {
+        const int lane = std::countr_zero(mask);
+        const float te = t[lane];  // never NaN: a NaN entry fails the kernel's t0 <= t1
+        std::size_t i = sp++;
+        while (i > base && st[i - 1].t <= te) st[i] = st[i - 1], --i;
+        st[i] = make(c0 + lane);
+        st[i].t = te;
+      }
+    }
+    if (sp == base) return Next::kPop;
+    it = st[--sp];
+    return Next::kEnter;
+  }
+
+  /// The first `m` (<= kChunk) boxes of the blocks at `blk`: one kernel call (as WideWalk).
+  template <BoxRays kRays>
+  [[gnu::always_inline]] static unsigned boxes(const WideBox4* blk, const WideRay& wr, float tmin,
+                                               float tmax, int m, float* t) {
+#if AMALGAM_WIDE_SSE
+#if defined(AMALGAM_ISA_AVX2)
+    if (m > kWideLanes) return box_test_lanes<Lanes8, kRays>(blk, wr, tmin, tmax, m, t);
+#endif
+    return box_test_lanes<Lanes4, kRays>(blk, wr, tmin, tmax, m, t);
+#else
+    return intersect_wide4(*blk, wr, tmin, tmax, m, t);
+#endif
+  }
+
+  /// `boxes` on the world boxes of the transformed object boxes of instance `in` in the
+  /// blocks at `blk` (`InstancedHierarchy::world_box` of each).
+  template <BoxRays kRays>
+  [[gnu::always_inline]] static unsigned world_boxes(const IH::InstanceData& in,
+                                                     const WideBox4* blk, const WideRay& wr,
+                                                     float tmin, float tmax, int m, float* t) {
+#if AMALGAM_WIDE_SSE
+#if defined(AMALGAM_ISA_AVX2)
+    if (m > kWideLanes) return world_box_test<Lanes8, kRays>(in, blk, wr, tmin, tmax, m, t);
+#endif
+    return world_box_test<Lanes4, kRays>(in, blk, wr, tmin, tmax, m, t);
+#else
+    WideBox4 w;
+    for (int l = 0; l < m; ++l) {
+      const Bbox b = IH::world_box(in, Bbox{{blk->lo[0][l], blk->lo[1][l], blk->lo[2][l]},
+                                            {blk->hi[0][l], blk->hi[1][l], blk->hi[2][l]}});
+      for (int a = 0; a < 3; ++a) w.lo[a][l] = b.lo[a], w.hi[a][l] = b.hi[a];
+    }
+    return intersect_wide4(w, wr, tmin, tmax, m, t);
+#endif
+  }
+
+#if AMALGAM_WIDE_SSE
+  /// world_box on L::kLanes boxes at once, in registers, then the box kernel on them. The
+  /// float operations are world_box's, in its order, lane by lane (no fused multiply-add: the
+  /// build enables none). An empty box (unused lanes included) keeps its bounds, as there.
+  template <class L, BoxRays kRays>
+  [[gnu::always_inline]] static unsigned world_box_test(const IH::InstanceData& in,
+                                                        const WideBox4* blk, const WideRay& wr,
+                                                        float tmin, float tmax, int m, float* t) {
+    using V = typename L::V;
+    constexpr std::uint32_t kHi = 3 * kWideLanes * sizeof(float);
+    V lo[3], hi[3], c[3], h[3];
+    const V half = L::set1(0.5f);
+    for (int a = 0; a < 3; ++a) {
+      const std::uint32_t axis = static_cast<std::uint32_t>(a * kWideLanes * sizeof(float));
+      lo[a] = L::load(blk, axis), hi[a] = L::load(blk, kHi + axis);
+      c[a] = L::mul(L::add(lo[a], hi[a]), half);  // Bbox::center
+      h[a] = L::mul(L::sub(hi[a], lo[a]), half);  // Bbox::extent() * 0.5f
+    }
+    const V empty = L::bor(L::bor(L::gt(lo[0], hi[0]), L::gt(lo[1], hi[1])), L::gt(lo[2], hi[2]));
+    const V sign = L::set1(-0.0f), k = L::set1(4.0f * gamma(3));
+    V wlo[3], whi[3];
+    for (int r = 0; r < 3; ++r) {
+      const float* mr = in.to_world.m[r];
+      // Transform::point: ((m0 x + m1 y) + m2 z) + m3.
+      const V cw = L::add(L::add(L::add(L::mul(L::set1(mr[0]), c[0]), L::mul(L::set1(mr[1]), c[1])),
+                                 L::mul(L::set1(mr[2]), c[2])),
+                          L::set1(mr[3]));
+      // dot(abs_rows[r], h): (x + y) + z; then r += (|c| + r) * 4 gamma(3).
+      const Vec3 ar = in.abs_rows[r];
+      V rw = L::add(L::add(L::mul(L::set1(ar.x), h[0]), L::mul(L::set1(ar.y), h[1])),
+                    L::mul(L::set1(ar.z), h[2]));
+      rw = L::add(rw, L::mul(L::add(L::andnot(sign, cw), rw), k));
+      wlo[r] = L::sub(cw, rw), whi[r] = L::add(cw, rw);
+    }
+    if (L::mask(empty) & ((1u << m) - 1u)) [[unlikely]] {
+      for (int r = 0; r < 3; ++r) {
+        wlo[r] = L::bor(L::band(empty, lo[r]), L::andnot(empty, wlo[r]));
+        whi[r] = L::bor(L::band(empty, hi[r]), L::andnot(empty, whi[r]));
+      }
+    }
+    return box_test_vectors<L, kRays>(wlo, whi, wr, tmin, tmax, m, t);
+  }
+#endif
+
+  /// The ray in the object space of instance `inst` (not an identity), set up for the pack
+  /// test once per instance entered: a ray's leaves in one instance come one after another.
+  const WideRay& object_ray(const State& s, const IH::InstanceData& in, std::uint32_t inst) {
+    if (obj_inst_ != inst) {
+      obj_inst_ = inst;
+      obj_wr_ = WideRay::of(IH::object_ray(in, s.ray));
+    }
+    return obj_wr_;
+  }
+
+  std::vector<StackItem> stack_;
+  std::uint32_t obj_inst_ = 0;  ///< the instance (+ 1) `obj_wr_` is for; 0: none yet
+  WideRay obj_wr_{};
+};
+
+AMALGAM_ISA_END
+}  // namespace amalgam
