@@ -131,6 +131,26 @@ std::vector<Vec3> bake_colours(const ExplicitHierarchy& h, bool parallel) {
   return colours;
 }
 
+/// What an exact bake adds for a hit on triangle `p`: its unit normal (its sign does not matter:
+/// the bake sums n n^T, bit for bit the same for -n) and, when `orientation` is not 0, its
+/// outward normal (none for a degenerate triangle).
+struct TriangleBake {
+  Vec3 normal, outward;
+  bool has_outward = false;
+  static TriangleBake of(const Primitive& p, int orientation) {
+    TriangleBake t{triangle_normal(p.a, p.b, p.c), {}};
+    if (orientation != 0) {
+      const Vec3 w = cross(p.b - p.a, p.c - p.a);
+      const float len = length(w);
+      if (len > 0.0f) t.outward = w * (static_cast<float>(orientation) / len), t.has_outward = true;
+    }
+    return t;
+  }
+};
+
+/// Leaves of up to this many primitives have their triangles' normals computed once per bake.
+constexpr std::uint32_t kCachedPrims = 8;
+
 /// Exact bake of node `id`: random lines traced (closest hit) against its subtree.
 /// `orientation`: closed_orientation of the hierarchy's primitives (0: triangles have no
 /// known outside, so the result is never kOriented when one is hit). `colours`: each
@@ -138,7 +158,16 @@ std::vector<Vec3> bake_colours(const ExplicitHierarchy& h, bool parallel) {
 BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeConfig& cfg,
                       int orientation, const std::vector<Vec3>& colours) {
   const int rays = std::max(cfg.rays, 1);
-  const Bbox box = h.nodes[id].bounds;
+  const ExplicitNode& top = h.nodes[id];
+  const LineSampler lines(top.bounds);
+  const std::uint64_t key = hash_combine(cfg.seed, id);
+  // A leaf's triangles (the common case) have their normals computed once, not per hit.
+  const bool cached = top.leaf && top.count <= kCachedPrims;
+  TriangleBake tri[kCachedPrims];
+  if (cached)
+    for (std::uint32_t k = 0; k < top.count; ++k)
+      if (h.prims[top.first + k].kind == PrimKind::kTriangle)
+        tri[k] = TriangleBake::of(h.prims[top.first + k], orientation);
   Vec3 colour{};
   float spec = 0.0f, shine = 0.0f;
   NormalTensor normals;
@@ -147,17 +176,14 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
   int hits = 0;
   std::vector<std::uint32_t> stack;
   for (int r = 0; r < rays; ++r) {
-    Sampler s(hash_combine(hash_combine(cfg.seed, id), static_cast<std::uint64_t>(r)));
     float u[6];
-    for (float& x : u) x = s.next();
-    u[0] = (static_cast<float>(r) + u[0]) / static_cast<float>(rays);
-    Ray ray = sample_line(box, u);
-    // Closest hit along the line. Triangles: the per-line set-up once and the SurfaceHit of
-    // the closest one only (what intersect() gives, without building it for every hit).
+    line_uniforms(key, r, rays, u);
+    Ray ray = lines(u);
+    // Closest hit along the line. Triangles: the per-line set-up once, and only the closest
+    // one's normal (sign-free, so no SurfaceHit is built for it).
     const TrianglePre pre = TrianglePre::of(ray);
-    TriangleCandidate cand{};
-    bool cand_best = false;  // the closest hit so far is the triangle candidate `cand`
-    std::optional<SurfaceHit> best;
+    bool hit = false, hit_triangle = false;
+    Vec3 hit_normal{};  // of a sphere or box hit, facing the line
     std::uint32_t best_prim = 0;
     auto leaf = [&](const ExplicitNode& n) {
       for (std::uint32_t p = n.first; p < n.first + n.count; ++p) {
@@ -165,16 +191,15 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
         if (prim.kind == PrimKind::kTriangle) {
           TriangleCandidate c;  // a failed test may leave partial values in it
           if (triangle_test(ray, pre, prim.a, prim.b, prim.c, c)) {
-            cand = c, cand_best = true, best_prim = p;
-            ray.tmax = cand.t;
+            hit = hit_triangle = true, best_prim = p;
+            ray.tmax = c.t;
           }
-        } else if (auto hit = intersect(prim, ray)) {
-          cand_best = false, best = hit, best_prim = p;
-          ray.tmax = hit->t;
+        } else if (auto s = intersect(prim, ray)) {
+          hit = true, hit_triangle = false, hit_normal = s->normal, best_prim = p;
+          ray.tmax = s->t;
         }
       }
     };
-    const ExplicitNode& top = h.nodes[id];
     if (top.leaf) {  // the common case: no stack
       leaf(top);
     } else {
@@ -190,27 +215,24 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
         for (std::uint32_t c = 0; c < n.count; ++c) stack.push_back(n.first + c);
       }
     }
-    if (cand_best) {
-      const Primitive& bp = h.prims[best_prim];
-      best = triangle_finish(ray, bp.a, bp.b, bp.c, cand);
-    }
-    if (!best) continue;
+    if (!hit) continue;
     ++hits;
-    const Surface& m = h.materials[h.prims[best_prim].material];
+    const Primitive& bp = h.prims[best_prim];
+    const Surface& m = h.materials[bp.material];
     colour += colours.empty() ? m.colour : colours[best_prim];
     spec += m.reflectance;
     shine += m.shininess;
-    normals.add(best->normal, 1.0f);
-    const Primitive& bp = h.prims[best_prim];
-    if (bp.kind != PrimKind::kTriangle) {
-      outward += best->normal;  // facing the line, which comes from outside the solid
-    } else if (orientation != 0) {
-      const Vec3 w = cross(bp.b - bp.a, bp.c - bp.a);
-      const float len = length(w);
-      if (len > 0.0f) outward += w * (static_cast<float>(orientation) / len);
-    } else {
-      oriented = false;
+    if (!hit_triangle) {
+      normals.add(hit_normal, 1.0f);
+      outward += hit_normal;  // facing the line, which comes from outside the solid
+      continue;
     }
+    const TriangleBake t = cached ? tri[best_prim - top.first] : TriangleBake::of(bp, orientation);
+    normals.add(t.normal, 1.0f);
+    if (orientation == 0)
+      oriented = false;
+    else if (t.has_outward)
+      outward += t.outward;
   }
   BakeResult r = finish_bake(rays, hits, colour, spec, shine, normals);
   if (oriented) orient(r, outward, static_cast<float>(hits));
