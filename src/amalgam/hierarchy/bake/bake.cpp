@@ -6,7 +6,10 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstddef>
+#include <new>
 #include <span>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -42,6 +45,15 @@ void for_each_level_bottom_up(std::span<const int> level, bool parallel, F&& bak
     }
   }
 }
+
+/// Room for a node's children as bake_from_children takes them, not initialised (a node has
+/// a few of the kMaxChildren it may have: each is constructed in place). BakeChild is trivially
+/// destructible.
+struct ChildBuffer {
+  alignas(BakeChild) std::byte raw[sizeof(BakeChild) * kMaxChildren];
+  BakeChild* data() { return reinterpret_cast<BakeChild*>(raw); }
+};
+static_assert(std::is_trivially_destructible_v<BakeChild>);
 
 /// Levels of `nodes` (children always have larger indices than their parent).
 std::vector<int> node_levels(const std::vector<ExplicitNode>& nodes) {
@@ -155,6 +167,8 @@ constexpr std::uint32_t kCachedPrims = 8;
 /// `orientation`: closed_orientation of the hierarchy's primitives (0: triangles have no
 /// known outside, so the result is never kOriented when one is hit). `colours`: each
 /// primitive's bake colour when the hierarchy is textured (else empty: the materials').
+/// kLeaf: the node is a leaf (the common case: no stack, no box tests).
+template <bool kLeaf>
 BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeConfig& cfg,
                       int orientation, const std::vector<Vec3>& colours) {
   const int rays = std::max(cfg.rays, 1);
@@ -200,7 +214,7 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
         }
       }
     };
-    if (top.leaf) {  // the common case: no stack
+    if constexpr (kLeaf) {
       leaf(top);
     } else {
       stack.assign(1, id);
@@ -262,15 +276,18 @@ void bake(ExplicitHierarchy& h, const BakeConfig& config) {
     const ExplicitNode& node = h.nodes[i];
     BakeResult r;
     if (node.leaf || prims_below[i] <= static_cast<std::uint64_t>(config.exact_prims)) {
-      r = bake_exact(h, static_cast<std::uint32_t>(i), config, orientation, colours);
+      const auto id = static_cast<std::uint32_t>(i);
+      r = node.leaf ? bake_exact<true>(h, id, config, orientation, colours)
+                    : bake_exact<false>(h, id, config, orientation, colours);
     } else {
-      BakeChild kids[kMaxChildren];
+      ChildBuffer buf;
+      BakeChild* kids = buf.data();
       AMALGAM_CHECK(node.count <= kMaxChildren,
                     "bake: a node with more than kMaxChildren children");
       const int k = node.count;
       for (int c = 0; c < k; ++c)
-        kids[c] = {h.nodes[node.first + c].bounds, h.appearances[node.first + c],
-                   tensors[node.first + c]};
+        new (&kids[c]) BakeChild{h.nodes[node.first + c].bounds, h.appearances[node.first + c],
+                                 tensors[node.first + c]};
       r = bake_from_children(node.bounds, std::span<const BakeChild>(kids, k), config.rays,
                              hash_combine(config.seed, i));
     }
@@ -288,7 +305,8 @@ void bake(InstancedHierarchy& h, const BakeConfig& config) {
   const BakeConfig& bc = config;
   auto bake_one = [&](std::size_t i) {
     const ExplicitNode& node = h.top_nodes[i];
-    BakeChild kids[kMaxChildren];
+    ChildBuffer buf;
+    BakeChild* kids = buf.data();
     AMALGAM_CHECK(node.count <= kMaxChildren, "bake: a node with more than kMaxChildren children");
     const int k = node.count;
     for (int c = 0; c < k; ++c) {
@@ -296,12 +314,13 @@ void bake(InstancedHierarchy& h, const BakeConfig& config) {
         const std::uint32_t inst = h.top_items[node.first + c];
         const auto& in = h.instances[inst];
         const NodeId root = InstancedHierarchy::id(inst + 1ull, 0);
-        kids[c] = {in.world_bounds, h.appearance(root),
-                   in.identity ? h.meshes[in.mesh].root_normals
-                               : transform_tensor(h.meshes[in.mesh].root_normals, in.normal_rows)};
+        new (&kids[c]) BakeChild{
+            in.world_bounds, h.appearance(root),
+            in.identity ? h.meshes[in.mesh].root_normals
+                        : transform_tensor(h.meshes[in.mesh].root_normals, in.normal_rows)};
       } else {
-        kids[c] = {h.top_nodes[node.first + c].bounds, h.top_appearances[node.first + c],
-                   tensors[node.first + c]};
+        new (&kids[c]) BakeChild{h.top_nodes[node.first + c].bounds,
+                                 h.top_appearances[node.first + c], tensors[node.first + c]};
       }
     }
     const BakeResult r = bake_from_children(node.bounds, std::span<const BakeChild>(kids, k),

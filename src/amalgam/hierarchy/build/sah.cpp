@@ -138,6 +138,15 @@ struct alignas(16) Ref {
   }
 };
 
+/// surface_area of the box [lo, hi] (spare lanes ignored), bit for bit: the same extent, and a
+/// box is empty (some lo > hi) exactly when some extent hi - lo is negative.
+float area(F4 lo, F4 hi) {
+  alignas(16) float e[4];
+  (hi - lo).store(e);
+  if (e[0] < 0.0f || e[1] < 0.0f || e[2] < 0.0f) return 0.0f;
+  return 2.0f * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
+}
+
 /// Bins of the three axes, `nb` of each used: their boxes and item counts.
 struct Bins {
   explicit Bins(int nb) : nb(nb) {
@@ -251,20 +260,20 @@ class BinaryBuilder {
     for (int a = 0; a < 3; ++a) {
       if (!(ext[a] > 0)) continue;
       float right_cost[kMaxBins];  // [k]: of bins k..nb-1, for k >= 1
-      Bbox acc;
+      F4 lo = F4::splat(kInfinity), hi = F4::splat(-kInfinity);
       std::uint32_t n = 0;
       for (int k = nb - 1; k > 0; --k) {
-        acc.extend(bins->box(a, k));
+        lo = min(bins->lo[a * nb + k], lo), hi = max(bins->hi[a * nb + k], hi);
         n += bins->n[a * nb + k];
-        right_cost[k] = n ? surface_area(acc) * static_cast<float>(n) : 0.0f;
+        right_cost[k] = n ? area(lo, hi) * static_cast<float>(n) : 0.0f;
       }
-      acc = Bbox{};
+      lo = F4::splat(kInfinity), hi = F4::splat(-kInfinity);
       n = 0;
       for (int k = 0; k < nb - 1; ++k) {
-        acc.extend(bins->box(a, k));
+        lo = min(bins->lo[a * nb + k], lo), hi = max(bins->hi[a * nb + k], hi);
         n += bins->n[a * nb + k];
         if (n == 0 || n == count) continue;
-        const float cost = surface_area(acc) * static_cast<float>(n) + right_cost[k + 1];
+        const float cost = area(lo, hi) * static_cast<float>(n) + right_cost[k + 1];
         if (cost < best_cost) best_cost = cost, s.axis = a, s.k = k;
       }
     }
