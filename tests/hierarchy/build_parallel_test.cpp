@@ -143,10 +143,10 @@ TEST(BakeLines, UniformsAreTheSamplersDraws) {
       for (float& x : w) x = s.next();
       w[0] = (static_cast<float>(r) + w[0]) / 16.0f;
       for (int d = 0; d < 6; ++d) ASSERT_EQ(u[d], w[d]) << key << " " << r << " " << d;
-      for (const Bbox& b : boxes) {  // a unit direction, from outside the box
+      for (const Bbox& b : boxes) {  // a unit direction, from outside a box with faces
         const Ray x = LineSampler(b)(u);
         EXPECT_NEAR(length(x.dir), 1.0f, 1e-5f);
-        EXPECT_FALSE(b.contains(x.origin));
+        if (surface_area(b) > 0.0f) EXPECT_FALSE(b.contains(x.origin));
       }
     }
 }
