@@ -146,7 +146,9 @@ TEST(BakeLines, UniformsAreTheSamplersDraws) {
       for (const Bbox& b : boxes) {  // a unit direction, from outside a box with faces
         const Ray x = LineSampler(b)(u);
         EXPECT_NEAR(length(x.dir), 1.0f, 1e-5f);
-        if (surface_area(b) > 0.0f) EXPECT_FALSE(b.contains(x.origin));
+        if (surface_area(b) > 0.0f) {
+          EXPECT_FALSE(b.contains(x.origin));
+        }
       }
     }
 }
