@@ -6,6 +6,9 @@
 
 #include <algorithm>
 #include <bit>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 #include <cstddef>
 #include <new>
 #include <span>
@@ -163,6 +166,65 @@ struct TriangleBake {
 /// Leaves of up to this many primitives have their triangles' normals computed once per bake.
 constexpr std::uint32_t kCachedPrims = 8;
 
+/// A leaf of 2 to 4 triangles in SoA form, for a first test of a line against all of them at
+/// once: triangle_test's edge functions (the same float operations on the same operands, so
+/// the same values) and its first rejection, mixed signs, where none is zero (a zero one is
+/// recomputed in double precision by triangle_test: such lanes stay). The lanes left are tested
+/// one by one, in order, as before: a rejection does not depend on the ray's tmax, so the
+/// closest hit and every bit of the bake are unchanged. Most lines miss most of a leaf's
+/// triangles.
+struct EdgeFilter {
+  alignas(16) float v[3][3][4];  // [vertex][axis][lane]
+  unsigned lanes = 0;            // the triangles' lanes; 0: no filter (test them all)
+
+  EdgeFilter(const ExplicitHierarchy& h, const ExplicitNode& n) {
+#if defined(__SSE2__)
+    if (n.count < 2 || n.count > 4) return;
+    for (std::uint32_t k = 0; k < n.count; ++k)
+      if (h.prims[n.first + k].kind != PrimKind::kTriangle) return;
+    for (int lane = 0; lane < 4; ++lane) {
+      const Primitive& p = h.prims[n.first + std::min<std::uint32_t>(lane, n.count - 1)];
+      for (int a = 0; a < 3; ++a)
+        v[0][a][lane] = p.a[a], v[1][a][lane] = p.b[a], v[2][a][lane] = p.c[a];
+    }
+    lanes = (1u << n.count) - 1u;
+#else
+    (void)h, (void)n;
+#endif
+  }
+
+  /// The lanes that may hit (bit k: the leaf's k-th triangle), or ~0u without a filter.
+  unsigned live(const Ray& ray, const TrianglePre& pre) const {
+    if (!lanes) return ~0u;
+#if defined(__SSE2__)
+    const __m128 ox = _mm_set1_ps(ray.origin[pre.kx]), oy = _mm_set1_ps(ray.origin[pre.ky]);
+    const __m128 oz = _mm_set1_ps(ray.origin[pre.kz]);
+    const __m128 sx = _mm_set1_ps(pre.sx), sy = _mm_set1_ps(pre.sy);
+    __m128 x[3], y[3];
+    for (int k = 0; k < 3; ++k) {  // A[kx] - sx * A[kz] with A = vertex - origin
+      const __m128 z = _mm_sub_ps(_mm_load_ps(v[k][pre.kz]), oz);
+      x[k] = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(v[k][pre.kx]), ox), _mm_mul_ps(sx, z));
+      y[k] = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(v[k][pre.ky]), oy), _mm_mul_ps(sy, z));
+    }
+    const __m128 u = _mm_sub_ps(_mm_mul_ps(x[2], y[1]), _mm_mul_ps(y[2], x[1]));
+    const __m128 vv = _mm_sub_ps(_mm_mul_ps(x[0], y[2]), _mm_mul_ps(y[0], x[2]));
+    const __m128 w = _mm_sub_ps(_mm_mul_ps(x[1], y[0]), _mm_mul_ps(y[1], x[0]));
+    const __m128 zero = _mm_setzero_ps();
+    const __m128 any_zero =
+        _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(vv, zero)), _mm_cmpeq_ps(w, zero));
+    const __m128 neg =
+        _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(vv, zero)), _mm_cmplt_ps(w, zero));
+    const __m128 pos =
+        _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(vv, zero)), _mm_cmpgt_ps(w, zero));
+    const __m128 reject = _mm_andnot_ps(any_zero, _mm_and_ps(neg, pos));
+    return lanes & ~static_cast<unsigned>(_mm_movemask_ps(reject));
+#else
+    (void)ray, (void)pre;
+    return ~0u;
+#endif
+  }
+};
+
 /// Exact bake of node `id`: random lines traced (closest hit) against its subtree.
 /// `orientation`: closed_orientation of the hierarchy's primitives (0: triangles have no
 /// known outside, so the result is never kOriented when one is hit). `colours`: each
@@ -182,6 +244,7 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
     for (std::uint32_t k = 0; k < top.count; ++k)
       if (h.prims[top.first + k].kind == PrimKind::kTriangle)
         tri[k] = TriangleBake::of(h.prims[top.first + k], orientation);
+  const EdgeFilter filter = kLeaf ? EdgeFilter(h, top) : EdgeFilter(h, ExplicitNode{});
   Vec3 colour{};
   float spec = 0.0f, shine = 0.0f;
   NormalTensor normals;
@@ -199,8 +262,9 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
     bool hit = false, hit_triangle = false;
     Vec3 hit_normal{};  // of a sphere or box hit, facing the line
     std::uint32_t best_prim = 0;
-    auto leaf = [&](const ExplicitNode& n) {
+    auto leaf = [&](const ExplicitNode& n, unsigned live) {
       for (std::uint32_t p = n.first; p < n.first + n.count; ++p) {
+        if (!((live >> std::min<std::uint32_t>(p - n.first, 31)) & 1u)) continue;
         const Primitive& prim = h.prims[p];
         if (prim.kind == PrimKind::kTriangle) {
           TriangleCandidate c;  // a failed test may leave partial values in it
@@ -215,7 +279,7 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
       }
     };
     if constexpr (kLeaf) {
-      leaf(top);
+      leaf(top, filter.live(ray, pre));
     } else {
       stack.assign(1, id);
     }
@@ -224,7 +288,7 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
       stack.pop_back();
       if (!intersect_box(ray, n.bounds)) continue;
       if (n.leaf) {
-        leaf(n);
+        leaf(n, ~0u);
       } else {
         for (std::uint32_t c = 0; c < n.count; ++c) stack.push_back(n.first + c);
       }
