@@ -1,6 +1,7 @@
 #include "amalgam/hierarchy/build/sah.h"
 
 #include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/parallel_invoke.h>
 #include <oneapi/tbb/parallel_reduce.h>
 
@@ -369,48 +370,86 @@ class BinaryBuilder {
 SahTree collapse(const BinaryBuilder& b, std::size_t items, const SahConfig& config) {
   const BinaryNode* bin = b.nodes_.get();
   const auto arity = static_cast<std::size_t>(std::clamp(config.arity, 2, kMaxChildren));
+  auto each = [&](std::size_t n, auto&& f) {
+    if (config.parallel && n >= 4096)
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t j = r.begin(); j < r.end(); ++j) f(j);
+                        });
+    else
+      for (std::size_t j = 0; j < n; ++j) f(j);
+  };
 
   // Collapse breadth-first: open the child with the largest surface area until a node has
-  // `arity` children (or only leaves are left).
+  // `arity` children (or only leaves are left). One level at a time: its nodes are opened in
+  // parallel, their children's and items' places follow in node order (a prefix sum), and
+  // are filled in parallel; the same tree as taking the nodes one by one from a queue.
   SahTree t;
-  t.order.reserve(items);
+  t.order.resize(items);
   t.nodes.push_back({bin[0].box, 0, 0, true});
   t.level.push_back(0);
   std::vector<std::uint32_t> queue{0};  // binary node of wide node q
-  std::vector<std::uint32_t> kids;
-  for (std::size_t q = 0; q < queue.size(); ++q) {
-    const BinaryNode& n = bin[queue[q]];
-    const std::uint8_t level = t.level[q];
-    t.depth = std::max<int>(t.depth, level);
-    if (n.leaf) {
-      t.nodes[q].first = static_cast<std::uint32_t>(t.order.size());
-      t.nodes[q].count = checked_narrow<std::uint16_t>(n.b, "SAH leaf size");
-      t.nodes[q].leaf = true;
-      for (std::uint32_t k = n.a; k < n.a + n.b; ++k) t.order.push_back(b.item(k));
-      continue;
-    }
-    kids = {n.a, n.b};
-    while (kids.size() < arity) {
-      int best = -1;
-      float best_area = -1.0f;
-      for (std::size_t i = 0; i < kids.size(); ++i) {
-        if (bin[kids[i]].leaf) continue;
-        const float area = surface_area(bin[kids[i]].box);
-        if (area > best_area) best_area = area, best = static_cast<int>(i);
+  std::vector<std::uint32_t> kids;      // of the level's node j: [j * arity, + count[j])
+  std::vector<std::uint32_t> count;
+  std::size_t next_item = 0;
+  for (std::size_t begin = 0, level = 0; begin < t.nodes.size(); ++level) {
+    const std::size_t end = t.nodes.size(), m = end - begin;
+    t.depth = static_cast<int>(std::min<std::size_t>(level, 255));
+    kids.resize(m * arity);
+    count.assign(m, 0);
+    each(m, [&](std::size_t j) {
+      const BinaryNode& n = bin[queue[begin + j]];
+      if (n.leaf) return;
+      std::uint32_t* k = kids.data() + j * arity;
+      std::size_t size = 2;
+      k[0] = n.a, k[1] = n.b;
+      while (size < arity) {
+        int best = -1;
+        float best_area = -1.0f;
+        for (std::size_t i = 0; i < size; ++i) {
+          if (bin[k[i]].leaf) continue;
+          const float area = surface_area(bin[k[i]].box);
+          if (area > best_area) best_area = area, best = static_cast<int>(i);
+        }
+        if (best < 0) break;
+        const BinaryNode& open = bin[k[best]];
+        std::copy_backward(k + best + 1, k + size, k + size + 1);
+        k[best] = open.a, k[best + 1] = open.b, ++size;
       }
-      if (best < 0) break;
-      const BinaryNode& open = bin[kids[static_cast<std::size_t>(best)]];
-      kids[static_cast<std::size_t>(best)] = open.a;
-      kids.insert(kids.begin() + best + 1, open.b);
+      count[j] = static_cast<std::uint32_t>(size);
+    });
+    std::size_t at = end;
+    for (std::size_t j = 0; j < m; ++j) {
+      const BinaryNode& n = bin[queue[begin + j]];
+      SahTree::Node& node = t.nodes[begin + j];
+      node.leaf = n.leaf;
+      if (n.leaf) {
+        node.first = static_cast<std::uint32_t>(next_item);
+        node.count = checked_narrow<std::uint16_t>(n.b, "SAH leaf size");
+        next_item += n.b;
+      } else {
+        node.first = static_cast<std::uint32_t>(at);
+        node.count = checked_narrow<std::uint16_t>(count[j], "SAH node arity");
+        at += count[j];
+      }
     }
-    t.nodes[q].first = static_cast<std::uint32_t>(t.nodes.size());
-    t.nodes[q].count = checked_narrow<std::uint16_t>(kids.size(), "SAH node arity");
-    t.nodes[q].leaf = false;
-    for (std::uint32_t k : kids) {
-      t.nodes.push_back({bin[k].box, 0, 0, true});
-      t.level.push_back(static_cast<std::uint8_t>(std::min(level + 1, 255)));
-      queue.push_back(k);
-    }
+    t.nodes.resize(at);
+    t.level.resize(at, static_cast<std::uint8_t>(std::min<std::size_t>(level + 1, 255)));
+    queue.resize(at);
+    each(m, [&](std::size_t j) {
+      const BinaryNode& n = bin[queue[begin + j]];
+      const SahTree::Node& node = t.nodes[begin + j];
+      if (n.leaf) {
+        for (std::uint32_t k = 0; k < n.b; ++k) t.order[node.first + k] = b.item(n.a + k);
+        return;
+      }
+      for (std::uint32_t c = 0; c < node.count; ++c) {
+        const std::uint32_t k = kids[j * arity + c];
+        t.nodes[node.first + c] = {bin[k].box, 0, 0, true};
+        queue[node.first + c] = k;
+      }
+    });
+    begin = end;
   }
   return t;
 }
