@@ -82,7 +82,7 @@ std::optional<SurfaceHit> intersect_triangle(const Ray& ray, Vec3 a, Vec3 b, Vec
   return triangle_finish(ray, a, b, c, h);
 }
 
-SurfaceHit triangle_finish(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, const TriangleCandidate& h) {
+Vec3 triangle_normal(Vec3 a, Vec3 b, Vec3 c) {
   Vec3 n = cross(b - a, c - a);
   const float l2 = dot(n, n);
   if (!(l2 > 0x1.0p-100f && l2 < 0x1.0p100f)) [[unlikely]] {
@@ -96,6 +96,11 @@ SurfaceHit triangle_finish(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, const Triangl
   } else {
     n = normalize(n);
   }
+  return n;
+}
+
+SurfaceHit triangle_finish(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, const TriangleCandidate& h) {
+  Vec3 n = triangle_normal(a, b, c);
   if (dot(n, ray.dir) > 0) n = -n;
   // Barycentric reconstruction: the error depends on the vertices, not on the ray origin.
   const float inv = 1.0f / h.det;

@@ -147,6 +147,11 @@ inline bool triangle_test(const Ray& ray, const TrianglePre& p, Vec3 a, Vec3 b, 
   return true;
 }
 
+/// The unit normal of triangle (a, b, c), (b - a) x (c - a) normalised (in double precision
+/// when its squared length would overflow or underflow in float); zero for a degenerate one.
+/// `triangle_finish` turns it to face the ray.
+Vec3 triangle_normal(Vec3 a, Vec3 b, Vec3 c);
+
 /// The full hit of a candidate from `triangle_test` on the same ray and triangle.
 SurfaceHit triangle_finish(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, const TriangleCandidate& h);
 

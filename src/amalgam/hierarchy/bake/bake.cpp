@@ -6,7 +6,13 @@
 
 #include <algorithm>
 #include <bit>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+#include <cstddef>
+#include <new>
 #include <span>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -42,6 +48,15 @@ void for_each_level_bottom_up(std::span<const int> level, bool parallel, F&& bak
     }
   }
 }
+
+/// Room for a node's children as bake_from_children takes them, not initialised (a node has
+/// a few of the kMaxChildren it may have: each is constructed in place). BakeChild is trivially
+/// destructible.
+struct ChildBuffer {
+  alignas(BakeChild) std::byte raw[sizeof(BakeChild) * kMaxChildren];
+  BakeChild* data() { return reinterpret_cast<BakeChild*>(raw); }
+};
+static_assert(std::is_trivially_destructible_v<BakeChild>);
 
 /// Levels of `nodes` (children always have larger indices than their parent).
 std::vector<int> node_levels(const std::vector<ExplicitNode>& nodes) {
@@ -131,14 +146,105 @@ std::vector<Vec3> bake_colours(const ExplicitHierarchy& h, bool parallel) {
   return colours;
 }
 
+/// What an exact bake adds for a hit on triangle `p`: its unit normal (its sign does not matter:
+/// the bake sums n n^T, bit for bit the same for -n) and, when `orientation` is not 0, its
+/// outward normal (none for a degenerate triangle).
+struct TriangleBake {
+  Vec3 normal, outward;
+  bool has_outward = false;
+  static TriangleBake of(const Primitive& p, int orientation) {
+    TriangleBake t{triangle_normal(p.a, p.b, p.c), {}};
+    if (orientation != 0) {
+      const Vec3 w = cross(p.b - p.a, p.c - p.a);
+      const float len = length(w);
+      if (len > 0.0f) t.outward = w * (static_cast<float>(orientation) / len), t.has_outward = true;
+    }
+    return t;
+  }
+};
+
+/// Leaves of up to this many primitives have their triangles' normals computed once per bake.
+constexpr std::uint32_t kCachedPrims = 8;
+
+/// A leaf of 2 to 4 triangles in SoA form, for a first test of a line against all of them at
+/// once: triangle_test's edge functions (the same float operations on the same operands, so
+/// the same values) and its first rejection, mixed signs, where none is zero (a zero one is
+/// recomputed in double precision by triangle_test: such lanes stay). The lanes left are tested
+/// one by one, in order, as before: a rejection does not depend on the ray's tmax, so the
+/// closest hit and every bit of the bake are unchanged. Most lines miss most of a leaf's
+/// triangles.
+struct EdgeFilter {
+  alignas(16) float v[3][3][4];  // [vertex][axis][lane]
+  unsigned lanes = 0;            // the triangles' lanes; 0: no filter (test them all)
+
+  EdgeFilter(const ExplicitHierarchy& h, const ExplicitNode& n) {
+#if defined(__SSE2__)
+    if (n.count < 2 || n.count > 4) return;
+    for (std::uint32_t k = 0; k < n.count; ++k)
+      if (h.prims[n.first + k].kind != PrimKind::kTriangle) return;
+    for (int lane = 0; lane < 4; ++lane) {
+      const Primitive& p = h.prims[n.first + std::min<std::uint32_t>(lane, n.count - 1)];
+      for (int a = 0; a < 3; ++a)
+        v[0][a][lane] = p.a[a], v[1][a][lane] = p.b[a], v[2][a][lane] = p.c[a];
+    }
+    lanes = (1u << n.count) - 1u;
+#else
+    (void)h, (void)n;
+#endif
+  }
+
+  /// The lanes that may hit (bit k: the leaf's k-th triangle), or ~0u without a filter.
+  unsigned live(const Ray& ray, const TrianglePre& pre) const {
+    if (!lanes) return ~0u;
+#if defined(__SSE2__)
+    const __m128 ox = _mm_set1_ps(ray.origin[pre.kx]), oy = _mm_set1_ps(ray.origin[pre.ky]);
+    const __m128 oz = _mm_set1_ps(ray.origin[pre.kz]);
+    const __m128 sx = _mm_set1_ps(pre.sx), sy = _mm_set1_ps(pre.sy);
+    __m128 x[3], y[3];
+    for (int k = 0; k < 3; ++k) {  // A[kx] - sx * A[kz] with A = vertex - origin
+      const __m128 z = _mm_sub_ps(_mm_load_ps(v[k][pre.kz]), oz);
+      x[k] = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(v[k][pre.kx]), ox), _mm_mul_ps(sx, z));
+      y[k] = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(v[k][pre.ky]), oy), _mm_mul_ps(sy, z));
+    }
+    const __m128 u = _mm_sub_ps(_mm_mul_ps(x[2], y[1]), _mm_mul_ps(y[2], x[1]));
+    const __m128 vv = _mm_sub_ps(_mm_mul_ps(x[0], y[2]), _mm_mul_ps(y[0], x[2]));
+    const __m128 w = _mm_sub_ps(_mm_mul_ps(x[1], y[0]), _mm_mul_ps(y[1], x[0]));
+    const __m128 zero = _mm_setzero_ps();
+    const __m128 any_zero =
+        _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(vv, zero)), _mm_cmpeq_ps(w, zero));
+    const __m128 neg =
+        _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(vv, zero)), _mm_cmplt_ps(w, zero));
+    const __m128 pos =
+        _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(vv, zero)), _mm_cmpgt_ps(w, zero));
+    const __m128 reject = _mm_andnot_ps(any_zero, _mm_and_ps(neg, pos));
+    return lanes & ~static_cast<unsigned>(_mm_movemask_ps(reject));
+#else
+    (void)ray, (void)pre;
+    return ~0u;
+#endif
+  }
+};
+
 /// Exact bake of node `id`: random lines traced (closest hit) against its subtree.
 /// `orientation`: closed_orientation of the hierarchy's primitives (0: triangles have no
 /// known outside, so the result is never kOriented when one is hit). `colours`: each
 /// primitive's bake colour when the hierarchy is textured (else empty: the materials').
+/// kLeaf: the node is a leaf (the common case: no stack, no box tests).
+template <bool kLeaf>
 BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeConfig& cfg,
                       int orientation, const std::vector<Vec3>& colours) {
   const int rays = std::max(cfg.rays, 1);
-  const Bbox box = h.nodes[id].bounds;
+  const ExplicitNode& top = h.nodes[id];
+  const LineSampler lines(top.bounds);
+  const std::uint64_t key = hash_combine(cfg.seed, id);
+  // A leaf's triangles (the common case) have their normals computed once, not per hit.
+  const bool cached = top.leaf && top.count <= kCachedPrims;
+  TriangleBake tri[kCachedPrims];
+  if (cached)
+    for (std::uint32_t k = 0; k < top.count; ++k)
+      if (h.prims[top.first + k].kind == PrimKind::kTriangle)
+        tri[k] = TriangleBake::of(h.prims[top.first + k], orientation);
+  const EdgeFilter filter = kLeaf ? EdgeFilter(h, top) : EdgeFilter(h, ExplicitNode{});
   Vec3 colour{};
   float spec = 0.0f, shine = 0.0f;
   NormalTensor normals;
@@ -147,36 +253,33 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
   int hits = 0;
   std::vector<std::uint32_t> stack;
   for (int r = 0; r < rays; ++r) {
-    Sampler s(hash_combine(hash_combine(cfg.seed, id), static_cast<std::uint64_t>(r)));
     float u[6];
-    for (float& x : u) x = s.next();
-    u[0] = (static_cast<float>(r) + u[0]) / static_cast<float>(rays);
-    Ray ray = sample_line(box, u);
-    // Closest hit along the line. Triangles: the per-line set-up once and the SurfaceHit of
-    // the closest one only (what intersect() gives, without building it for every hit).
+    line_uniforms(key, r, rays, u);
+    Ray ray = lines(u);
+    // Closest hit along the line. Triangles: the per-line set-up once, and only the closest
+    // one's normal (sign-free, so no SurfaceHit is built for it).
     const TrianglePre pre = TrianglePre::of(ray);
-    TriangleCandidate cand{};
-    bool cand_best = false;  // the closest hit so far is the triangle candidate `cand`
-    std::optional<SurfaceHit> best;
+    bool hit = false, hit_triangle = false;
+    Vec3 hit_normal{};  // of a sphere or box hit, facing the line
     std::uint32_t best_prim = 0;
-    auto leaf = [&](const ExplicitNode& n) {
+    auto leaf = [&](const ExplicitNode& n, unsigned live) {
       for (std::uint32_t p = n.first; p < n.first + n.count; ++p) {
+        if (!((live >> std::min<std::uint32_t>(p - n.first, 31)) & 1u)) continue;
         const Primitive& prim = h.prims[p];
         if (prim.kind == PrimKind::kTriangle) {
           TriangleCandidate c;  // a failed test may leave partial values in it
           if (triangle_test(ray, pre, prim.a, prim.b, prim.c, c)) {
-            cand = c, cand_best = true, best_prim = p;
-            ray.tmax = cand.t;
+            hit = hit_triangle = true, best_prim = p;
+            ray.tmax = c.t;
           }
-        } else if (auto hit = intersect(prim, ray)) {
-          cand_best = false, best = hit, best_prim = p;
-          ray.tmax = hit->t;
+        } else if (auto s = intersect(prim, ray)) {
+          hit = true, hit_triangle = false, hit_normal = s->normal, best_prim = p;
+          ray.tmax = s->t;
         }
       }
     };
-    const ExplicitNode& top = h.nodes[id];
-    if (top.leaf) {  // the common case: no stack
-      leaf(top);
+    if constexpr (kLeaf) {
+      leaf(top, filter.live(ray, pre));
     } else {
       stack.assign(1, id);
     }
@@ -185,32 +288,29 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
       stack.pop_back();
       if (!intersect_box(ray, n.bounds)) continue;
       if (n.leaf) {
-        leaf(n);
+        leaf(n, ~0u);
       } else {
         for (std::uint32_t c = 0; c < n.count; ++c) stack.push_back(n.first + c);
       }
     }
-    if (cand_best) {
-      const Primitive& bp = h.prims[best_prim];
-      best = triangle_finish(ray, bp.a, bp.b, bp.c, cand);
-    }
-    if (!best) continue;
+    if (!hit) continue;
     ++hits;
-    const Surface& m = h.materials[h.prims[best_prim].material];
+    const Primitive& bp = h.prims[best_prim];
+    const Surface& m = h.materials[bp.material];
     colour += colours.empty() ? m.colour : colours[best_prim];
     spec += m.reflectance;
     shine += m.shininess;
-    normals.add(best->normal, 1.0f);
-    const Primitive& bp = h.prims[best_prim];
-    if (bp.kind != PrimKind::kTriangle) {
-      outward += best->normal;  // facing the line, which comes from outside the solid
-    } else if (orientation != 0) {
-      const Vec3 w = cross(bp.b - bp.a, bp.c - bp.a);
-      const float len = length(w);
-      if (len > 0.0f) outward += w * (static_cast<float>(orientation) / len);
-    } else {
-      oriented = false;
+    if (!hit_triangle) {
+      normals.add(hit_normal, 1.0f);
+      outward += hit_normal;  // facing the line, which comes from outside the solid
+      continue;
     }
+    const TriangleBake t = cached ? tri[best_prim - top.first] : TriangleBake::of(bp, orientation);
+    normals.add(t.normal, 1.0f);
+    if (orientation == 0)
+      oriented = false;
+    else if (t.has_outward)
+      outward += t.outward;
   }
   BakeResult r = finish_bake(rays, hits, colour, spec, shine, normals);
   if (oriented) orient(r, outward, static_cast<float>(hits));
@@ -240,15 +340,18 @@ void bake(ExplicitHierarchy& h, const BakeConfig& config) {
     const ExplicitNode& node = h.nodes[i];
     BakeResult r;
     if (node.leaf || prims_below[i] <= static_cast<std::uint64_t>(config.exact_prims)) {
-      r = bake_exact(h, static_cast<std::uint32_t>(i), config, orientation, colours);
+      const auto id = static_cast<std::uint32_t>(i);
+      r = node.leaf ? bake_exact<true>(h, id, config, orientation, colours)
+                    : bake_exact<false>(h, id, config, orientation, colours);
     } else {
-      BakeChild kids[kMaxChildren];
+      ChildBuffer buf;
+      BakeChild* kids = buf.data();
       AMALGAM_CHECK(node.count <= kMaxChildren,
                     "bake: a node with more than kMaxChildren children");
       const int k = node.count;
       for (int c = 0; c < k; ++c)
-        kids[c] = {h.nodes[node.first + c].bounds, h.appearances[node.first + c],
-                   tensors[node.first + c]};
+        new (&kids[c]) BakeChild{h.nodes[node.first + c].bounds, h.appearances[node.first + c],
+                                 tensors[node.first + c]};
       r = bake_from_children(node.bounds, std::span<const BakeChild>(kids, k), config.rays,
                              hash_combine(config.seed, i));
     }
@@ -266,7 +369,8 @@ void bake(InstancedHierarchy& h, const BakeConfig& config) {
   const BakeConfig& bc = config;
   auto bake_one = [&](std::size_t i) {
     const ExplicitNode& node = h.top_nodes[i];
-    BakeChild kids[kMaxChildren];
+    ChildBuffer buf;
+    BakeChild* kids = buf.data();
     AMALGAM_CHECK(node.count <= kMaxChildren, "bake: a node with more than kMaxChildren children");
     const int k = node.count;
     for (int c = 0; c < k; ++c) {
@@ -274,12 +378,13 @@ void bake(InstancedHierarchy& h, const BakeConfig& config) {
         const std::uint32_t inst = h.top_items[node.first + c];
         const auto& in = h.instances[inst];
         const NodeId root = InstancedHierarchy::id(inst + 1ull, 0);
-        kids[c] = {in.world_bounds, h.appearance(root),
-                   in.identity ? h.meshes[in.mesh].root_normals
-                               : transform_tensor(h.meshes[in.mesh].root_normals, in.normal_rows)};
+        new (&kids[c]) BakeChild{
+            in.world_bounds, h.appearance(root),
+            in.identity ? h.meshes[in.mesh].root_normals
+                        : transform_tensor(h.meshes[in.mesh].root_normals, in.normal_rows)};
       } else {
-        kids[c] = {h.top_nodes[node.first + c].bounds, h.top_appearances[node.first + c],
-                   tensors[node.first + c]};
+        new (&kids[c]) BakeChild{h.top_nodes[node.first + c].bounds,
+                                 h.top_appearances[node.first + c], tensors[node.first + c]};
       }
     }
     const BakeResult r = bake_from_children(node.bounds, std::span<const BakeChild>(kids, k),

@@ -5,7 +5,6 @@
 
 #include "amalgam/hierarchy/bake/lines.h"
 #include "amalgam/hierarchy/hierarchy.h"
-#include "amalgam/math/random.h"
 #include "amalgam/util/check.h"
 
 namespace amalgam {
@@ -61,12 +60,11 @@ BakeResult bake_from_children(const Bbox& box, std::span<const BakeChild> kids, 
   AMALGAM_CHECK(kids.size() <= static_cast<std::size_t>(kMaxChildren),
                 "bake_from_children: more children than kMaxChildren");
   rays = std::max(rays, 1);
+  const LineSampler lines(box);
   for (int r = 0; r < rays; ++r) {
-    Sampler s(hash_combine(key, static_cast<std::uint64_t>(r)));
     float u[6];
-    for (float& x : u) x = s.next();
-    u[0] = (static_cast<float>(r) + u[0]) / static_cast<float>(rays);
-    const Ray ray = sample_line(box, u);
+    line_uniforms(key, r, rays, u);
+    const Ray ray = lines(u);
     int n = 0;
     for (int k = 0; k < static_cast<int>(kids.size()); ++k) {
       if (!(kids[k].app.opacity > 0.0f)) continue;

@@ -9,6 +9,7 @@
 #include <bit>
 #include <cmath>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "amalgam/math/random.h"
@@ -21,19 +22,45 @@ namespace {
 /// (counted, then scattered in order), then each bucket is sorted on its own, in parallel. The
 /// keys are hashes, so the buckets are even and each fits in cache. The whole check at 10^6
 /// triangles (3 * 10^6 keys, 2 cores): 0.22 s with one parallel sort of the array, 0.12 s so.
+/// The counting and the scattering run in parallel too, over fixed chunks of the keys (each
+/// chunk's keys go to their buckets after those of the chunks before it): the buckets are
+/// sorted afterwards, so the result is the serial one whatever the threads.
 void sort_keys(std::vector<std::uint64_t>& keys) {
   constexpr int kBits = 12;
   constexpr std::size_t kBuckets = std::size_t{1} << kBits;
+  constexpr std::size_t kChunk = std::size_t{1} << 18;
   if (keys.size() < 4 * kBuckets) {
     std::sort(keys.begin(), keys.end());
     return;
   }
+  const std::size_t chunks = (keys.size() + kChunk - 1) / kChunk;
+  // count[c * kBuckets + b]: keys of chunk c in bucket b, then where they go.
+  std::vector<std::size_t> count(chunks * kBuckets, 0);
+  auto chunk_range = [&](std::size_t c) {
+    return std::pair{c * kChunk, std::min(keys.size(), (c + 1) * kChunk)};
+  };
+  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+    const auto [b, e] = chunk_range(c);
+    std::size_t* n = count.data() + c * kBuckets;
+    for (std::size_t i = b; i < e; ++i) ++n[keys[i] >> (64 - kBits)];
+  });
   std::vector<std::size_t> start(kBuckets + 1, 0);
-  for (std::uint64_t k : keys) ++start[(k >> (64 - kBits)) + 1];
-  for (std::size_t b = 0; b < kBuckets; ++b) start[b + 1] += start[b];
+  std::size_t at = 0;
+  for (std::size_t b = 0; b < kBuckets; ++b) {
+    start[b] = at;
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::size_t n = count[c * kBuckets + b];
+      count[c * kBuckets + b] = at;
+      at += n;
+    }
+  }
+  start[kBuckets] = at;
   std::vector<std::uint64_t> out(keys.size());
-  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-  for (std::uint64_t k : keys) out[fill[k >> (64 - kBits)]++] = k;
+  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+    const auto [b, e] = chunk_range(c);
+    std::size_t* fill = count.data() + c * kBuckets;
+    for (std::size_t i = b; i < e; ++i) out[fill[keys[i] >> (64 - kBits)]++] = keys[i];
+  });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kBuckets, 16),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t b = r.begin(); b < r.end(); ++b)
@@ -112,17 +139,33 @@ int closed_orientation(std::span<const Primitive> prims) {
   sort_keys(edges);
   edges.resize(edges.size() - skipped.load());
   if (edges.empty()) return 0;
-  std::size_t paired = 0;
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i + 1;
-    while (j < edges.size() && (edges[j] >> 1) == (edges[i] >> 1)) ++j;
-    if (j - i == 2 && edges[i] != edges[i + 1]) {
-      paired += 2;
-    } else if (j - i != 1) {
-      return 0;
-    }
-    i = j;
-  }
+  // The runs of equal pairs, in parallel over ranges of the sorted keys (a range starts at the
+  // first run that begins in it): the paired keys counted, any inconsistent run flagged.
+  struct Runs {
+    std::size_t paired = 0;
+    bool inconsistent = false;
+  };
+  const Runs runs = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, edges.size(), 1u << 16), Runs{},
+      [&](const tbb::blocked_range<std::size_t>& r, Runs v) {
+        std::size_t i = r.begin();
+        while (i > 0 && i < r.end() && (edges[i] >> 1) == (edges[i - 1] >> 1)) ++i;
+        while (i < r.end() && !v.inconsistent) {
+          std::size_t j = i + 1;
+          while (j < edges.size() && (edges[j] >> 1) == (edges[i] >> 1)) ++j;
+          if (j - i == 2 && edges[i] != edges[i + 1])
+            v.paired += 2;
+          else if (j - i != 1)
+            v.inconsistent = true;
+          i = j;
+        }
+        return v;
+      },
+      [](Runs a, const Runs& b) {
+        return Runs{a.paired + b.paired, a.inconsistent || b.inconsistent};
+      });
+  if (runs.inconsistent) return 0;
+  const std::size_t paired = runs.paired;
   if (paired * 20 < edges.size() * 19) return 0;
   return volume > 0.0 ? 1 : -1;
 }

@@ -1,0 +1,157 @@
+// The build and bake give the same bytes whatever runs in parallel: the SAH's parallel binning
+// and subtrees, the bake's levels, build_wide's passes; and the bake's shortcuts draw the same
+// numbers as the plain forms they replace.
+
+#include <gtest/gtest.h>
+#include <oneapi/tbb/global_control.h>
+
+#include <cmath>
+#include <cstring>
+#include <set>
+#include <vector>
+
+#include "amalgam/hierarchy/bake/lines.h"
+#include "amalgam/hierarchy/build/build.h"
+#include "amalgam/hierarchy/build/sah.h"
+#include "amalgam/hierarchy/explicit.h"
+#include "amalgam/math/random.h"
+
+namespace amalgam {
+namespace {
+
+/// Small triangles in a few clusters, every 97th primitive a sphere (non-triangle leaves), and
+/// a closed box of 12 triangles (so that the bake orients flat amalgams).
+std::vector<Primitive> scene(int n) {
+  std::vector<Primitive> out;
+  Sampler s(17);
+  for (int i = 0; i < n; ++i) {
+    const Vec3 c{static_cast<float>(i % 5) * 4.0f + s.next(), s.next() * 3.0f, s.next()};
+    if (i % 97 == 0) {
+      out.push_back(Primitive::sphere(c, 0.02f, static_cast<std::uint32_t>(i % 3)));
+      continue;
+    }
+    const auto r = [&] { return Vec3{s.next(), s.next(), s.next()} * 0.04f; };
+    out.push_back(Primitive::triangle(c, c + r() + Vec3{0.04f, 0, 0}, c + r() + Vec3{0, 0.04f, 0},
+                                      static_cast<std::uint32_t>(i % 3)));
+  }
+  const Vec3 v[8] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                     {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
+  const int f[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                        {2, 3, 7}, {2, 7, 6}, {1, 2, 6}, {1, 6, 5}, {0, 4, 7}, {0, 7, 3}};
+  for (const auto& t : f) out.push_back(Primitive::triangle(v[t[0]], v[t[1]], v[t[2]], 1));
+  return out;
+}
+
+/// Every byte that a build produces, padding excluded.
+void expect_same(const ExplicitHierarchy& a, const ExplicitHierarchy& b) {
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  ASSERT_EQ(a.prims.size(), b.prims.size());
+  EXPECT_EQ(a.levels, b.levels);
+  for (std::size_t i = 0; i < a.nodes.size(); ++i) {
+    const ExplicitNode &x = a.nodes[i], &y = b.nodes[i];
+    ASSERT_TRUE(x.bounds == y.bounds && x.first == y.first && x.count == y.count &&
+                x.leaf == y.leaf)
+        << "node " << i;
+    const Appearance &p = a.appearances[i], &q = b.appearances[i];
+    ASSERT_EQ(std::memcmp(&p.surface.colour, &q.surface.colour, sizeof(Vec3)), 0) << i;
+    ASSERT_EQ(std::memcmp(&p.normal, &q.normal, sizeof(Vec3)), 0) << "node " << i;
+    ASSERT_TRUE(std::memcmp(&p.opacity, &q.opacity, 4) == 0 && p.shading == q.shading &&
+                std::memcmp(&p.surface.reflectance, &q.surface.reflectance, 4) == 0 &&
+                std::memcmp(&p.surface.shininess, &q.surface.shininess, 4) == 0)
+        << "node " << i;
+  }
+  for (std::size_t i = 0; i < a.prims.size(); ++i) {
+    const Primitive &x = a.prims[i], &y = b.prims[i];
+    ASSERT_TRUE(x.kind == y.kind && x.material == y.material && x.a == y.a && x.b == y.b &&
+                x.c == y.c && x.radius == y.radius)
+        << "primitive " << i;
+  }
+  EXPECT_EQ(std::memcmp(&a.root_normals, &b.root_normals, sizeof(NormalTensor)), 0);
+  ASSERT_EQ(a.wide.headers.size(), b.wide.headers.size());
+  ASSERT_EQ(a.wide.blocks.size(), b.wide.blocks.size());
+  ASSERT_EQ(a.wide.tris.size(), b.wide.tris.size());
+  EXPECT_EQ(std::memcmp(a.wide.headers.data(), b.wide.headers.data(),
+                        a.wide.headers.size() * sizeof(WideHeader)),
+            0);
+  EXPECT_EQ(std::memcmp(a.wide.blocks.data(), b.wide.blocks.data(),
+                        a.wide.blocks.size() * sizeof(WideBox4)),
+            0);
+  EXPECT_EQ(std::memcmp(a.wide.tris.data(), b.wide.tris.data(),
+                        a.wide.tris.size() * sizeof(TrianglePack4)),
+            0);
+}
+
+TEST(BuildParallel, SerialParallelAndOneThreadGiveTheSameBytes) {
+  // Above every parallel threshold: the SAH's parallel binning (2^16 items), its parallel
+  // subtrees, the bake's parallel levels, build_wide's parallel passes (16,384 nodes).
+  const std::vector<Primitive> prims = scene(90000);
+  const std::vector<Surface> materials = {Surface{{1, 0, 0}}, Surface{{0, 1, 0}, 0.5f, 8.0f},
+                                          Surface{{0, 0, 1}}};
+  for (int exact : {4, 16}) {  // 16: interior nodes baked exactly too (the stack path)
+    SCOPED_TRACE("exact_prims " + std::to_string(exact));
+    BuildConfig parallel;
+    parallel.bake.exact_prims = exact;
+    BuildConfig serial = parallel;
+    serial.parallel = false;
+    const ExplicitHierarchy a = build_explicit(prims, materials, parallel);
+    ASSERT_GT(a.nodes.size(), 16384u);
+    expect_same(a, build_explicit(prims, materials, serial));
+    {
+      tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+      expect_same(a, build_explicit(prims, materials, parallel));
+    }
+    // build_wide again on the built hierarchy (one thread or many): the same blocks.
+    ExplicitHierarchy c = a;
+    c.wide = {};
+    build_wide(c);
+    expect_same(a, c);
+  }
+}
+
+TEST(BuildParallel, NonFiniteBoxesKeepEveryItemOnceAndParallelEqualsSerial) {
+  std::vector<Bbox> boxes;
+  Sampler s(5);
+  const float nan = std::nanf(""), inf = kInfinity;
+  for (int i = 0; i < 70000; ++i) {
+    const Vec3 c{s.next() * 10.0f, s.next() * 10.0f, s.next()};
+    Bbox b = Bbox::of(c, c + Vec3{0.01f, 0.01f, 0.01f});
+    if (i % 501 == 0) b.lo.x = nan;
+    if (i % 703 == 0) b.hi.y = inf;
+    if (i % 907 == 0) b.lo.z = -inf;
+    boxes.push_back(b);
+  }
+  SahConfig serial;
+  serial.parallel = false;
+  const SahTree a = build_sah(boxes), b = build_sah(boxes, serial);
+  EXPECT_EQ(a.order, b.order);
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  for (std::size_t i = 0; i < a.nodes.size(); ++i)
+    EXPECT_EQ(std::memcmp(&a.nodes[i].bounds, &b.nodes[i].bounds, sizeof(Bbox)), 0) << i;
+  const std::set<std::uint32_t> items(a.order.begin(), a.order.end());
+  EXPECT_EQ(items.size(), boxes.size());
+  EXPECT_EQ(a.order.size(), boxes.size());
+}
+
+TEST(BakeLines, UniformsAreTheSamplersDraws) {
+  const Bbox boxes[] = {Bbox::of({0, 0, 0}, {1, 2, 3}), Bbox::of({-1, 5, 2}, {-1, 5, 2.5f}),
+                        Bbox::of({3, 3, 3}, {3, 3, 3})};
+  for (std::uint64_t key : {0ull, 0x6a6bull, 0xffffffffffffffffull})
+    for (int r = 0; r < 16; ++r) {
+      float u[6], w[6];
+      line_uniforms(key, r, 16, u);
+      Sampler s(hash_combine(key, static_cast<std::uint64_t>(r)));
+      for (float& x : w) x = s.next();
+      w[0] = (static_cast<float>(r) + w[0]) / 16.0f;
+      for (int d = 0; d < 6; ++d) ASSERT_EQ(u[d], w[d]) << key << " " << r << " " << d;
+      for (const Bbox& b : boxes) {  // a unit direction, from outside a box with faces
+        const Ray x = LineSampler(b)(u);
+        EXPECT_NEAR(length(x.dir), 1.0f, 1e-5f);
+        if (surface_area(b) > 0.0f) {
+          EXPECT_FALSE(b.contains(x.origin));
+        }
+      }
+    }
+}
+
+}  // namespace
+}  // namespace amalgam
