@@ -268,6 +268,22 @@ inline unsigned intersect_wide4(const WideBox4& b, const WideRay& r, float tmin,
 #endif
 }
 
+/// The first `m` boxes of the blocks at `blk` (m <= 8 in the AVX2 copy, two blocks; <= 4
+/// otherwise): one kernel call, the 8-lane one when more than four (a scalar loop without SSE,
+/// exact for any ray).
+template <BoxRays kRays>
+[[gnu::always_inline]] inline unsigned box_test_blocks(const WideBox4* blk, const WideRay& wr,
+                                                       float tmin, float tmax, int m, float* t) {
+#if AMALGAM_WIDE_SSE
+#if defined(AMALGAM_ISA_AVX2)
+  if (m > kWideLanes) return box_test_lanes<Lanes8, kRays>(blk, wr, tmin, tmax, m, t);
+#endif
+  return box_test_lanes<Lanes4, kRays>(blk, wr, tmin, tmax, m, t);
+#else
+  return intersect_wide4(*blk, wr, tmin, tmax, m, t);
+#endif
+}
+
 /// A pack test's candidates by lane (valid where its hit mask is set); N = 4, or 8 for two
 /// packs tested at once (AVX2).
 template <int N>

@@ -130,7 +130,7 @@ class InstancedWalk {
     return children(
         s, it, st, cap, sp, hd.count, cl,
         [&](int c0, int m, float* t) {
-          return boxes<kRays>(blk + c0 / kWideLanes, wr, s.ray.tmin, s.ray.tmax, m, t);
+          return box_test_blocks<kRays>(blk + c0 / kWideLanes, wr, s.ray.tmin, s.ray.tmax, m, t);
         },
         [&](int c) {
           return instances ? StackItem{0, 0, items[c] + 1u, cl}
@@ -171,7 +171,7 @@ class InstancedWalk {
       return children(
           s, it, st, cap, sp, count, cl,
           [&](int c0, int m, float* t) {
-            return boxes<kRays>(blk + c0 / kWideLanes, wr, s.ray.tmin, s.ray.tmax, m, t);
+            return box_test_blocks<kRays>(blk + c0 / kWideLanes, wr, s.ray.tmin, s.ray.tmax, m, t);
           },
           child);
     }
@@ -211,20 +211,6 @@ class InstancedWalk {
     if (sp == base) return Next::kPop;
     it = st[--sp];
     return Next::kEnter;
-  }
-
-  /// The first `m` (<= kChunk) boxes of the blocks at `blk`: one kernel call (as WideWalk).
-  template <BoxRays kRays>
-  [[gnu::always_inline]] static unsigned boxes(const WideBox4* blk, const WideRay& wr, float tmin,
-                                               float tmax, int m, float* t) {
-#if AMALGAM_WIDE_SSE
-#if defined(AMALGAM_ISA_AVX2)
-    if (m > kWideLanes) return box_test_lanes<Lanes8, kRays>(blk, wr, tmin, tmax, m, t);
-#endif
-    return box_test_lanes<Lanes4, kRays>(blk, wr, tmin, tmax, m, t);
-#else
-    return intersect_wide4(*blk, wr, tmin, tmax, m, t);
-#endif
   }
 
   /// `boxes` on the world boxes of the transformed object boxes of instance `in` in the

@@ -212,7 +212,8 @@ class WideWalk {
       // The kernel tests all lanes of kOneCall / 4 blocks (a node of up to 4 children reads
       // the block after its own too: no branch on the count, and WideNodes keeps a spare block
       // at the end); the header's mask keeps the children's lanes.
-      const unsigned mask = boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, kOneCall, t) & hd.lanes;
+      const unsigned mask =
+          box_test_blocks<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, kOneCall, t) & hd.lanes;
       if (mask == 0) return Next::kPop;
       const int l0 = std::countr_zero(mask);
       const unsigned rest = mask & (mask - 1);
@@ -240,14 +241,14 @@ class WideWalk {
     for (; count - c0 > kWideLanes; c0 += 2 * kWideLanes, blk += 2) {
       alignas(32) float t[2 * kWideLanes];
       const int m = std::min(count - c0, 2 * kWideLanes);
-      push_sorted(st, sp, boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, m, t), t,
+      push_sorted(st, sp, box_test_blocks<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, m, t), t,
                   hd.first + static_cast<std::uint32_t>(c0), cl, base);
     }
 #endif
     for (; c0 < count; c0 += kWideLanes, ++blk) {
       alignas(16) float t[kWideLanes];
       const int m = std::min(count - c0, kWideLanes);
-      push_sorted(st, sp, boxes<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, m, t), t,
+      push_sorted(st, sp, box_test_blocks<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, m, t), t,
                   hd.first + static_cast<std::uint32_t>(c0), cl, base);
     }
     if (sp == base) return Next::kPop;
@@ -260,21 +261,6 @@ class WideWalk {
     if (need <= cap) return;
     stack_.resize(2 * cap + need);
     st = stack_.data(), cap = stack_.size();
-  }
-
-  /// The first `m` boxes of the blocks at `blk` (m <= 8 with AVX2, <= 4 otherwise): one
-  /// kernel call.
-  template <BoxRays kRays>
-  [[gnu::always_inline]] static unsigned boxes(const WideBox4* blk, const WideRay& wr, float tmin,
-                                               float tmax, int m, float* t) {
-#if AMALGAM_WIDE_SSE
-#if defined(AMALGAM_ISA_AVX2)
-    if (m > kWideLanes) return box_test_lanes<Lanes8, kRays>(blk, wr, tmin, tmax, m, t);
-#endif
-    return box_test_lanes<Lanes4, kRays>(blk, wr, tmin, tmax, m, t);
-#else
-    return intersect_wide4(*blk, wr, tmin, tmax, m, t);  // the scalar test: exact for any ray
-#endif
   }
 
   /// Pushes the lanes of `mask` (children `first + lane`, entered at `t[lane]`) onto the stack
