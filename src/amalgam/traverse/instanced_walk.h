@@ -90,30 +90,15 @@ class InstancedWalk {
     StackItem it{t_root, 0, 0, 0};
     for (;;) {
       s.counters.count_reached(s.kind);
-      bool rendered = false;
-      if constexpr (State::kMayRender) {
-        if (s.lod.may_render(it.level)) {
-          const NodeId id = IH::id(it.inst, it.node);
-          const Bbox b = s.h.bounds(id);
-          if (s.renders(b, it.level, it.t)) {
-            s.render_amalgam(id, it.level, b, it.t);
-            rendered = true;
-          }
-        }
-      }
       Next next;
-      if (rendered)
+      if (s.render_if_policy(IH::id(it.inst, it.node), it.level, it.t))
         next = s.done ? Next::kStop : Next::kPop;
       else if (it.inst == 0)
         next = top_node<kRays>(s, top, wr, it, st, cap, sp);
       else
         next = instance_node<kRays>(s, wr, it, st, cap, sp);
       if (next == Next::kEnter) continue;
-      if (next == Next::kStop) return;
-      do {
-        if (sp == 0) return;
-        it = st[--sp];
-      } while (it.t > s.ray.tmax);
+      if (next == Next::kStop || !s.pop_nearer(it, st, sp)) return;
     }
   }
 

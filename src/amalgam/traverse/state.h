@@ -9,6 +9,7 @@
 /// volume.
 
 #include <algorithm>
+#include <cstddef>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -90,6 +91,32 @@ struct RayState {
   bool renders(const Bbox& b, int level, float t) const {
     return lod.may_render(level) &&
            lod.render(b, level, ray, t, t <= ray.tmin && b.contains(ray.origin));
+  }
+
+  /// The fast walks' step on reaching node `id` (level `level`, entered at `t`): when the LOD
+  /// policy renders it, renders it (true); else false: the walk descends.
+  [[gnu::always_inline]] bool render_if_policy(NodeId id, int level, float t) {
+    if constexpr (kMayRender) {
+      if (lod.may_render(level)) {
+        const Bbox b = h.bounds(id);
+        if (renders(b, level, t)) {
+          render_amalgam(id, level, b, t);
+          return true;
+        }
+      }
+    }
+    return false;
+  }
+
+  /// Pops the next entry of the stack `st[0, sp)` of a fast walk into `it`, skipping those
+  /// entered beyond the closest hit so far; false when none is left.
+  template <class Item>
+  [[gnu::always_inline]] bool pop_nearer(Item& it, const Item* st, std::size_t& sp) const {
+    do {
+      if (sp == 0) return false;
+      it = st[--sp];
+    } while (it.t > ray.tmax);
+    return true;
   }
 
   /// A shadow ray met something opaque.

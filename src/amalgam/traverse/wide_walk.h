@@ -139,25 +139,12 @@ class WideWalk {
     StackItem it = st[0];
     for (;;) {
       s.counters.count_reached(s.kind);
-      bool rendered = false;
-      if constexpr (State::kMayRender) {
-        if (s.lod.may_render(it.level)) {
-          const Bbox b = s.h.bounds(it.node);
-          if (s.renders(b, it.level, it.t)) {
-            s.render_amalgam(it.node, it.level, b, it.t);
-            rendered = true;
-          }
-        }
-      }
-      const Next next = !rendered ? expand<kRays>(s, arr, wr, it, st, cap, sp)
-                        : s.done  ? Next::kStop
-                                  : Next::kPop;
+      const Next next = !s.render_if_policy(it.node, it.level, it.t)
+                            ? expand<kRays>(s, arr, wr, it, st, cap, sp)
+                        : s.done ? Next::kStop
+                                 : Next::kPop;
       if (next == Next::kEnter) continue;
-      if (next == Next::kStop) return;
-      do {
-        if (sp == 0) return;
-        it = st[--sp];
-      } while (it.t > s.ray.tmax);
+      if (next == Next::kStop || !s.pop_nearer(it, st, sp)) return;
     }
   }
 
