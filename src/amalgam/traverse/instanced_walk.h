@@ -113,7 +113,7 @@ class InstancedWalk {
     const std::uint32_t* items = s.h.top_items.data() + hd.first;
     const bool instances = hd.leaf == kWideLeaf;
     return children(
-        s, it, st, cap, sp, hd.count, cl,
+        it, st, cap, sp, hd.count,
         [&](int c0, int m, float* t) {
           return box_test_blocks<kRays>(blk + c0 / kWideLanes, wr, s.ray.tmin, s.ray.tmax, m, t);
         },
@@ -154,29 +154,27 @@ class InstancedWalk {
     };
     if (in.identity) {
       return children(
-          s, it, st, cap, sp, count, cl,
+          it, st, cap, sp, count,
           [&](int c0, int m, float* t) {
             return box_test_blocks<kRays>(blk + c0 / kWideLanes, wr, s.ray.tmin, s.ray.tmax, m, t);
           },
           child);
     }
     return children(
-        s, it, st, cap, sp, count, cl,
+        it, st, cap, sp, count,
         [&](int c0, int m, float* t) {
           return world_boxes<kRays>(in, blk + c0 / kWideLanes, wr, s.ray.tmin, s.ray.tmax, m, t);
         },
         child);
   }
 
-  /// The hit children of a node of `count` children on level `cl`, tested `kChunk` at a time
+  /// The hit children of a node of `count` children, tested `kChunk` at a time
   /// by `test(c0, m, t)` (the mask of the hit lanes among children c0 .. c0 + m, their
   /// entries in t), pushed farthest first as WideWalk does (ties: stored order); `make(c)` is
   /// child c's stack item (its t filled in here). kEnter with `it` the nearest hit child.
   template <class Test, class Make>
-  [[gnu::always_inline]] Next children(State& s, StackItem& it, StackItem*& st, std::size_t& cap,
-                                       std::size_t& sp, int count, int cl, Test&& test,
-                                       Make&& make) {
-    (void)s, (void)cl;
+  [[gnu::always_inline]] Next children(StackItem& it, StackItem*& st, std::size_t& cap,
+                                       std::size_t& sp, int count, Test&& test, Make&& make) {
     if (sp + static_cast<std::size_t>(count) > cap) {
       stack_.resize(2 * cap + static_cast<std::size_t>(count));
       st = stack_.data(), cap = stack_.size();
