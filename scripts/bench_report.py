@@ -190,9 +190,26 @@ for s in scenes:
 L.append("\nBoth builders use all cores. \"of which bake\": `bake()` timed again alone on the built hierarchy;")
 L.append("\"closed-surface check\": its `closed_orientation` (whether the triangles bound closed, consistently")
 L.append("wound solids, for the outward normals of flat amalgams), timed alone.")
-L.append("Ours: nodes + appearances + primitives (48-byte triangles, reordered copy) + the SoA child")
-L.append("boxes and triangle packs of the SIMD traversal. Embree: bytes its device allocated during `rtcCommitScene`")
-L.append("(memory monitor), and that plus the shared vertex/index buffers it was given.\n")
+L.append("Ours: what the built hierarchy holds (by structure below). Embree: bytes its device allocated")
+L.append("during `rtcCommitScene` (memory monitor), and that plus the shared vertex/index buffers it was")
+L.append("given.\n")
+if any("ours_prims_bytes_per_tri" in b for b in builds.values()):
+    L.append("Ours by structure, bytes per triangle: nodes (`ExplicitNode`, 32 B per node), appearances")
+    L.append("(44 B per node), the SIMD traversal's nodes (a 12-byte header per node, the SoA child boxes")
+    L.append("of interior nodes, 96 B per four children) and the primitives (src/amalgam/hierarchy/")
+    L.append("primitives.h: a triangle of a triangle-only leaf is stored once, in the SoA pack the")
+    L.append("traversal tests, 144 B per four triangles, unused lanes padded, plus its 4-byte material")
+    L.append("and 4-byte slot; any other primitive as a 48-byte `Primitive`).\n")
+    L.append("| scene | nodes | appearances | SIMD nodes | primitives | total |")
+    L.append("|---|---:|---:|---:|---:|---:|")
+    for s in scenes:
+        b = builds.get(s)
+        if b and "ours_prims_bytes_per_tri" in b:
+            L.append("| %s | %.1f | %.1f | %.1f | %.1f | %.1f |" % (
+                s, b["ours_nodes_bytes_per_tri"], b["ours_appearances_bytes_per_tri"],
+                b["ours_simd_nodes_bytes_per_tri"], b["ours_prims_bytes_per_tri"],
+                b["ours_bytes_per_tri"]))
+    L.append("")
 L.append("## Whole renders of the field: Embree at full detail vs amalgam scale-sensitive\n")
 L.append("`build/bench/amalgam_field_bench` (bench/field_bench.cpp).")
 field_tables(L)

@@ -84,7 +84,7 @@ TEST(Isa, Avx2CopyGivesThePortableBits) {
     BuildConfig c;
     c.arity = arity;
     c.leaf_size = arity;
-    w.hierarchy = build_explicit(e.prims, e.materials, c);
+    w.hierarchy = build_explicit(e.prims.to_vector(), e.materials, c);
     w.name += " (arity and leaves " + std::to_string(arity) + ")";
     scenes.push_back(std::move(w));
   }

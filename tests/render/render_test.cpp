@@ -115,7 +115,7 @@ TEST(Render, StochasticOpacityIsUnbiased) {
     h.levels = 3;
     const Bbox box{{-1, -1, -1}, {1, 1, 1}};
     h.nodes = {{box, 1, 1, false}, {box, 0, 1, true}};
-    h.prims = {Primitive::sphere({0, 0, 0}, 0.5f)};
+    h.prims = std::vector<Primitive>{Primitive::sphere({0, 0, 0}, 0.5f)};
     h.materials = {Surface{}};
     Appearance root, amalgam;
     amalgam.opacity = a;

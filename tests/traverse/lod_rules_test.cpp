@@ -31,8 +31,8 @@ void add_corners(std::vector<Primitive>& out, Vec3 lo, Vec3 hi) {
 /// so a rendered amalgam stops any ray. Built by hand, with the SIMD boxes of the fast path.
 ExplicitHierarchy two_amalgams() {
   ExplicitHierarchy h;
-  add_corners(h.prims, {-2, -1, -1}, {-1, 1, 1});
-  add_corners(h.prims, {1, -1, -1}, {2, 1, 1});
+  add_corners(h.prims.edit(), {-2, -1, -1}, {-1, 1, 1});
+  add_corners(h.prims.edit(), {1, -1, -1}, {2, 1, 1});
   h.nodes = {{{{-2, -1, -1}, {2, 1, 1}}, 1, 2, false},
              {{{-2, -1, -1}, {-1, 1, 1}}, 0, 2, true},
              {{{1, -1, -1}, {2, 1, 1}}, 2, 2, true}};

@@ -9,6 +9,7 @@
 
 #include "amalgam/hierarchy/bake/normals.h"
 #include "amalgam/hierarchy/hierarchy.h"
+#include "amalgam/hierarchy/primitives.h"
 #include "amalgam/hierarchy/wide.h"
 #include "amalgam/scene/texture.h"
 
@@ -25,7 +26,8 @@ class ExplicitHierarchy {
  public:
   std::vector<ExplicitNode> nodes;
   std::vector<Appearance> appearances;  ///< one per node
-  std::vector<Primitive> prims;
+  /// In leaf order; packed by `build_wide` (hierarchy/primitives.h).
+  PrimitiveStore prims;
   std::vector<Surface> materials;  ///< indexed by Primitive::material
   /// Texture coordinates per primitive (same order as `prims`) when a material is textured,
   /// else empty: a side table, so untextured scenes pay nothing.
@@ -52,11 +54,11 @@ class ExplicitHierarchy {
   std::optional<SurfaceHit> intersect(PrimId id, const Ray& ray) const {
     return amalgam::intersect(prims[id], ray);
   }
-  Surface surface(PrimId id) const { return materials[prims[id].material]; }
+  Surface surface(PrimId id) const { return materials[prims.material(id)]; }
   /// The surface at hit `s` on primitive `id`: its texture, if any, sampled at the
   /// coordinates interpolated with the hit's barycentrics, times the material's colour.
   Surface surface_at(PrimId id, const SurfaceHit& s) const {
-    Surface m = materials[prims[id].material];
+    Surface m = materials[prims.material(id)];
     if (m.texture >= 0) {
       if (!uvs.empty() && textures && static_cast<std::size_t>(m.texture) < textures->size()) {
         float u, v;
@@ -71,15 +73,17 @@ class ExplicitHierarchy {
   /// textured, the texture's mean over the triangle's texture coordinates (or over all its
   /// texels when the primitive has no coordinates).
   Vec3 bake_colour(PrimId id) const {
-    const Surface& m = materials[prims[id].material];
+    const Surface& m = materials[prims.material(id)];
     if (m.texture < 0 || !textures || static_cast<std::size_t>(m.texture) >= textures->size())
       return m.colour;
     const Texture& t = (*textures)[static_cast<std::size_t>(m.texture)];
     return m.colour * (uvs.empty() ? t.mean : mean_over_triangle(t, uvs[id]));
   }
-  /// The SoA child boxes when they match `nodes` (else null: the traversal's generic path).
+  /// The SoA child boxes when they match `nodes` and the primitives are packed (else null: the
+  /// traversal's generic path).
   const WideNodes* wide_nodes() const {
-    return !nodes.empty() && wide.headers.size() == nodes.size() ? &wide : nullptr;
+    return !nodes.empty() && wide.headers.size() == nodes.size() && prims.packed() ? &wide
+                                                                                   : nullptr;
   }
   HierarchyInfo info() const {
     return {static_cast<double>(prims.size()), static_cast<double>(nodes.size()), levels};

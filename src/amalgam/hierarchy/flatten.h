@@ -38,7 +38,7 @@ ExplicitHierarchy flatten(const H& src, int max_levels) {
         Primitive p = src.primitive(c.id);
         p.material = static_cast<std::uint32_t>(out.materials.size());
         out.materials.push_back(src.surface(c.id));
-        out.prims.push_back(p);
+        out.prims.edit().push_back(p);
       }
     } else {
       node.first = static_cast<std::uint32_t>(out.nodes.size());

@@ -1,33 +1,13 @@
 #include "amalgam/hierarchy/wide.h"
 
-#include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/parallel_for.h>
-
 #include <algorithm>
-#include <limits>
 
 #include "amalgam/hierarchy/explicit.h"
 #include "amalgam/hierarchy/instanced.h"
-
-namespace {
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-}  // namespace
+#include "amalgam/util/parallel.h"
 
 namespace amalgam {
 namespace {
-
-/// Calls f(i) for i in [0, n), in parallel when n is large.
-template <class F>
-void each(std::size_t n, F&& f) {
-  if (n < 16384) {
-    for (std::size_t i = 0; i < n; ++i) f(i);
-    return;
-  }
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t i = r.begin(); i < r.end(); ++i) f(i);
-                    });
-}
 
 /// Fills `b` with the boxes of children c0 .. c0 + 3 of a node of `count` children, `box(c)`
 /// (unused lanes empty).
@@ -48,12 +28,13 @@ std::uint8_t lane_mask(int count) {
 
 void build_wide(ExplicitHierarchy& h) {
   WideNodes& w = h.wide;
+  const std::vector<Primitive>& prims = h.prims.edit();  // the whole form, to classify and pack
   const std::size_t n = h.nodes.size();
   w.headers.assign(n, WideHeader{});
   // Each node's header but for where its blocks or packs start (in parallel: a leaf reads its
-  // primitives), then those starts in node order (a prefix sum), then the blocks and packs (in
-  // parallel again): the layout of a serial pass over the nodes, bit for bit.
-  each(n, [&](std::size_t i) {
+  // primitives), then those starts in node order (a prefix sum), then the blocks (in parallel
+  // again) and the packs: the layout of a serial pass over the nodes, bit for bit.
+  for_each_index(n, [&](std::size_t i) {
     const ExplicitNode& nd = h.nodes[i];
     WideHeader& hd = w.headers[i];
     hd.first = nd.first;
@@ -63,16 +44,17 @@ void build_wide(ExplicitHierarchy& h) {
     if (!nd.leaf) return;
     bool triangles = nd.count > 0;
     for (int j = 0; j < nd.count; ++j)
-      triangles = triangles && h.prims[nd.first + j].kind == PrimKind::kTriangle;
+      triangles = triangles && prims[nd.first + j].kind == PrimKind::kTriangle;
     if (triangles) hd.leaf = kWideTriangleLeaf;  // else spheres or boxes: the scalar loop
   });
-  std::size_t n_blocks = 0, n_packs = 0;
+  std::size_t n_blocks = 0;
+  std::vector<PrimRange> leaves;
   for (WideHeader& hd : w.headers) {
-    const std::size_t k = (hd.count + kWideLanes - 1) / kWideLanes;
     if (hd.leaf == kWideInterior) {
-      hd.block = static_cast<std::uint32_t>(n_blocks), n_blocks += k;
+      hd.block = static_cast<std::uint32_t>(n_blocks);
+      n_blocks += (hd.count + kWideLanes - 1) / kWideLanes;
     } else if (hd.leaf == kWideTriangleLeaf) {
-      hd.block = static_cast<std::uint32_t>(n_packs), n_packs += k;
+      leaves.push_back({hd.first, hd.count});
     } else {
       hd.block = static_cast<std::uint32_t>(n_blocks);  // as the blocks' size at this node
     }
@@ -80,28 +62,20 @@ void build_wide(ExplicitHierarchy& h) {
   // One spare block: the AVX2 walk tests a node of up to 4 children with the 8-lane kernel
   // too, reading the block after its own (lanes masked off by WideHeader::lanes).
   w.blocks.assign(n_blocks + 1, WideBox4{});
-  w.tris.resize(n_packs);
-  each(n, [&](std::size_t i) {
+  for_each_index(n, [&](std::size_t i) {
     const ExplicitNode& nd = h.nodes[i];
     const WideHeader& hd = w.headers[i];
-    if (hd.leaf == kWideTriangleLeaf) {
-      for (int c0 = 0, b = 0; c0 < nd.count; c0 += kWideLanes, ++b) {
-        TrianglePack4& pack = w.tris[hd.block + static_cast<std::size_t>(b)];
-        for (int lane = 0; lane < kWideLanes; ++lane) {
-          const int c = c0 + lane;
-          for (int k = 0; k < 3; ++k) {
-            const Primitive* p = c < nd.count ? &h.prims[nd.first + c] : nullptr;
-            const Vec3 vtx = !p ? Vec3{kNaN, kNaN, kNaN} : k == 0 ? p->a : k == 1 ? p->b : p->c;
-            for (int a = 0; a < 3; ++a) pack.v[k][a][lane] = vtx[a];
-          }
-        }
-      }
-    } else if (hd.leaf == kWideInterior) {
+    if (hd.leaf == kWideInterior)
       for (int c0 = 0, b = 0; c0 < nd.count; c0 += kWideLanes, ++b)
         fill_block(w.blocks[hd.block + static_cast<std::size_t>(b)], c0, nd.count,
                    [&](int c) { return h.nodes[nd.first + c].bounds; });
-    }
   });
+  // The triangle leaves' packs, in node order; the primitives keep only what the packs lack.
+  std::vector<std::uint32_t> first_pack(leaves.size());
+  h.prims.pack(leaves, first_pack);
+  std::size_t k = 0;
+  for (WideHeader& hd : w.headers)
+    if (hd.leaf == kWideTriangleLeaf) hd.block = first_pack[k++];
 }
 
 void build_wide(InstancedHierarchy& h) {
@@ -110,7 +84,6 @@ void build_wide(InstancedHierarchy& h) {
   WideNodes& w = h.top_wide;
   w.headers.assign(h.top_nodes.size(), WideHeader{});
   w.blocks.clear();
-  w.tris.clear();
   for (std::size_t i = 0; i < h.top_nodes.size(); ++i) {
     const ExplicitNode& n = h.top_nodes[i];
     WideHeader& hd = w.headers[i];

@@ -1,12 +1,14 @@
 #pragma once
 /// \file The node data of an explicit hierarchy as the SIMD traversal reads it: per node a
-/// 12-byte header, the SoA boxes of an interior node's children, and SoA packs of the
-/// triangles of a triangle-only leaf (geometry/wide.h).
+/// 12-byte header and the SoA boxes of an interior node's children (geometry/wide.h); the
+/// triangles of triangle-only leaves are SoA packs in the primitive store
+/// (`ExplicitHierarchy::prims`, hierarchy/primitives.h).
 ///
-/// `WideNodes` is derived data: `build_wide` fills it from `ExplicitHierarchy::nodes` and
+/// `WideNodes` is derived data: `build_wide` fills it from `ExplicitHierarchy::nodes` and packs
 /// `prims` (called at the end of `bake`, so `build_explicit` always has it). The traversal
-/// uses it only when it has one header per node (`ExplicitHierarchy::wide_nodes`); a hierarchy
-/// whose nodes or primitives are edited afterwards must call `build_wide` again.
+/// uses it only when it has one header per node and the primitives are packed
+/// (`ExplicitHierarchy::wide_nodes`); a hierarchy whose nodes or primitives are edited
+/// afterwards must call `build_wide` again.
 
 #include <cstdint>
 #include <vector>
@@ -23,14 +25,14 @@ class InstancedHierarchy;
 enum : std::uint8_t {
   kWideInterior = 0,
   kWideLeaf = 1,          ///< primitives tested one by one (a leaf with non-triangles)
-  kWideTriangleLeaf = 2,  ///< triangles only: ceil(count / 4) packs in `tris` from `block`
+  kWideTriangleLeaf = 2,  ///< triangles only: ceil(count / 4) packs from `block`
 };
 
 /// A node as the fast traversal reads it (12 bytes instead of ExplicitNode's 32).
 struct WideHeader {
   std::uint32_t first = 0;  ///< first child (node or primitive), as ExplicitNode::first
   /// Interior nodes: first of ceil(count / 4) blocks in `blocks`; triangle leaves: first of
-  /// ceil(count / 4) packs in `tris`.
+  /// ceil(count / 4) packs in `ExplicitHierarchy::prims.packs()`.
   std::uint32_t block = 0;
   std::uint16_t count = 0;
   std::uint8_t leaf = kWideInterior;
@@ -44,14 +46,12 @@ struct WideNodes {
   /// Children's boxes of every interior node, and one spare block at the end (an 8-lane read
   /// of the last node's single block stays inside the vector).
   std::vector<WideBox4> blocks;
-  std::vector<TrianglePack4> tris;  ///< triangles of every triangle-only leaf, leaf order
   std::size_t bytes() const {
-    return headers.size() * sizeof(WideHeader) + blocks.size() * sizeof(WideBox4) +
-           tris.size() * sizeof(TrianglePack4);
+    return headers.size() * sizeof(WideHeader) + blocks.size() * sizeof(WideBox4);
   }
 };
 
-/// (Re)builds `h.wide` from `h.nodes`.
+/// (Re)builds `h.wide` from `h.nodes` and packs `h.prims` (unpacking them first if packed).
 void build_wide(ExplicitHierarchy& h);
 
 /// (Re)builds `h.top_wide` from `h.top_nodes`, and the `WideNodes` of every mesh that has none

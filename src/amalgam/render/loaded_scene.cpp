@@ -53,7 +53,7 @@ struct Hasher {
   }
   void add(const ExplicitHierarchy& e) {
     add(static_cast<std::uint64_t>(e.prims.size()));
-    for (const Primitive& p : e.prims) add(p);
+    for (std::size_t i = 0; i < e.prims.size(); ++i) add(e.prims[i]);
     add(static_cast<std::uint64_t>(e.materials.size()));
     for (const Surface& m : e.materials) add(m);
     if (!e.uvs.empty()) {  // textured: coordinates and images (absent before textures existed)

@@ -56,7 +56,7 @@ class InstancedWalk {
   static void finish(State& s) {
     const IH& h = s.h;
     const IH::InstanceData& in = h.instances[IH::slot(s.hit.id) - 1];
-    const Primitive& p = h.meshes[in.mesh].prims[IH::local(s.hit.id)];
+    const Primitive p = h.meshes[in.mesh].prims[IH::local(s.hit.id)];
     if (in.identity) {
       s.hit.surf = triangle_finish(s.ray, p.a, p.b, p.c, s.cand);
     } else {
@@ -129,13 +129,15 @@ class InstancedWalk {
                      std::size_t& sp) {
     const std::uint32_t inst = it.inst;
     const IH::InstanceData& in = s.h.instances[inst - 1];
-    const WideNodes& w = s.h.meshes[in.mesh].wide;
+    const ExplicitHierarchy& mesh = s.h.meshes[in.mesh];
+    const WideNodes& w = mesh.wide;
     const WideHeader hd = w.headers[it.node];
     const int cl = it.level + 1;
     const int count = hd.count;
     if (hd.leaf == kWideTriangleLeaf) {
       const WideRay& owr = in.identity ? wr : object_ray(s, in, inst);
-      PackLeaf<State>::test(s, w.tris.data() + hd.block, owr, IH::id(inst, hd.first), count, cl);
+      PackLeaf<State>::test(s, mesh.prims.packs().data() + hd.block, owr, IH::id(inst, hd.first),
+                            count, cl);
       return s.done ? Next::kStop : Next::kPop;
     }
     if (hd.leaf == kWideLeaf) {  // spheres or boxes: the generic path's test

@@ -25,7 +25,8 @@ namespace amalgam {
 template <class H>
 concept WideHierarchy = requires(const H& h, std::size_t i) {
   { h.wide_nodes() } -> std::same_as<const WideNodes*>;
-  { h.prims[i] } -> std::convertible_to<const Primitive&>;
+  { h.prims[i] } -> std::convertible_to<Primitive>;
+  { h.prims.packs().data() } -> std::convertible_to<const TrianglePack4*>;
 };
 
 AMALGAM_ISA_BEGIN
@@ -107,7 +108,7 @@ class WideWalk {
 
   /// Builds the SurfaceHit of the closest hit when it is a deferred triangle.
   static void finish(State& s) {
-    const Primitive& p = s.h.prims[s.hit.id];
+    const Primitive p = s.h.prims[s.hit.id];
     s.hit.surf = triangle_finish(s.ray, p.a, p.b, p.c, s.cand);
     s.pending = false;
   }
@@ -133,7 +134,7 @@ class WideWalk {
     // reloaded after every store to the stack (a float store may alias them).
     const WideRay wr = WideRay::of(s.ray);
     tri_ = wr.pre;  // for the primitives of mixed leaves (`primitive`)
-    const Arrays arr{w.headers.data(), w.blocks.data(), w.tris.data()};
+    const Arrays arr{w.headers.data(), w.blocks.data(), s.h.prims.packs().data()};
     StackItem* st = stack_.data();
     std::size_t cap = stack_.size(), sp = 0;
     StackItem it = st[0];
@@ -269,7 +270,7 @@ class WideWalk {
   /// One primitive of a mixed leaf: triangles with the per-ray setup and a deferred
   /// SurfaceHit; other kinds through the full kernel (as ExplicitHierarchy::intersect).
   void primitive(State& s, std::uint32_t id, int level) {
-    const Primitive& p = s.h.prims[id];
+    const Primitive p = s.h.prims[id];
     if (p.kind == PrimKind::kTriangle) {
       TriangleCandidate c;
       if (triangle_test(s.ray, tri_, p.a, p.b, p.c, c)) s.on_triangle(id, level, c);

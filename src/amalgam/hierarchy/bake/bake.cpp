@@ -83,7 +83,7 @@ std::vector<Vec3> bake_colours(const ExplicitHierarchy& h, bool parallel) {
   const std::size_t n = h.prims.size();
   colours.resize(n);
   auto key_words = [&](std::size_t p, std::uint32_t w[7]) {
-    w[0] = h.prims[p].material;
+    w[0] = h.prims.unpacked(p).material;
     if (h.uvs.empty()) {
       std::fill(w + 1, w + 7, 0u);
       return;
@@ -181,9 +181,9 @@ struct EdgeFilter {
 #if defined(__SSE2__)
     if (n.count < 2 || n.count > 4) return;
     for (std::uint32_t k = 0; k < n.count; ++k)
-      if (h.prims[n.first + k].kind != PrimKind::kTriangle) return;
+      if (h.prims.unpacked(n.first + k).kind != PrimKind::kTriangle) return;
     for (int lane = 0; lane < 4; ++lane) {
-      const Primitive& p = h.prims[n.first + std::min<std::uint32_t>(lane, n.count - 1)];
+      const Primitive& p = h.prims.unpacked(n.first + std::min<std::uint32_t>(lane, n.count - 1));
       for (int a = 0; a < 3; ++a)
         v[0][a][lane] = p.a[a], v[1][a][lane] = p.b[a], v[2][a][lane] = p.c[a];
     }
@@ -242,8 +242,8 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
   TriangleBake tri[kCachedPrims];
   if (cached)
     for (std::uint32_t k = 0; k < top.count; ++k)
-      if (h.prims[top.first + k].kind == PrimKind::kTriangle)
-        tri[k] = TriangleBake::of(h.prims[top.first + k], orientation);
+      if (h.prims.unpacked(top.first + k).kind == PrimKind::kTriangle)
+        tri[k] = TriangleBake::of(h.prims.unpacked(top.first + k), orientation);
   const EdgeFilter filter = kLeaf ? EdgeFilter(h, top) : EdgeFilter(h, ExplicitNode{});
   Vec3 colour{};
   float spec = 0.0f, shine = 0.0f;
@@ -265,7 +265,7 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
     auto leaf = [&](const ExplicitNode& n, unsigned live) {
       for (std::uint32_t p = n.first; p < n.first + n.count; ++p) {
         if (!((live >> std::min<std::uint32_t>(p - n.first, 31)) & 1u)) continue;
-        const Primitive& prim = h.prims[p];
+        const Primitive& prim = h.prims.unpacked(p);
         if (prim.kind == PrimKind::kTriangle) {
           TriangleCandidate c;  // a failed test may leave partial values in it
           if (triangle_test(ray, pre, prim.a, prim.b, prim.c, c)) {
@@ -295,7 +295,7 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
     }
     if (!hit) continue;
     ++hits;
-    const Primitive& bp = h.prims[best_prim];
+    const Primitive& bp = h.prims.unpacked(best_prim);
     const Surface& m = h.materials[bp.material];
     colour += colours.empty() ? m.colour : colours[best_prim];
     spec += m.reflectance;
@@ -321,8 +321,10 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
 
 void bake(ExplicitHierarchy& h, const BakeConfig& config) {
   const std::size_t n = h.nodes.size();
+  // The whole form: the bake reads every primitive many times (build_wide packs them again).
+  const std::vector<Primitive>& prims = h.prims.edit();
   const int orientation =
-      h.prims.size() <= config.orient_max_triangles ? closed_orientation(h.prims) : 0;
+      prims.size() <= config.orient_max_triangles ? closed_orientation(prims) : 0;
   h.appearances.assign(n, Appearance{});
   const std::vector<Vec3> colours = bake_colours(h, config.parallel);
   std::vector<NormalTensor> tensors(n);

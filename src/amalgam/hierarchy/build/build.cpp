@@ -68,8 +68,9 @@ ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surfa
   };
   each(prims.size(), [&](std::size_t i) { boxes[i] = bounds(prims[i]); });
   SahTree t = build_sah(std::move(boxes), sah_config(config));
-  h.prims.resize(prims.size());
-  each(prims.size(), [&](std::size_t i) { h.prims[i] = prims[t.order[i]]; });
+  std::vector<Primitive>& ordered = h.prims.edit();
+  ordered.resize(prims.size());
+  each(prims.size(), [&](std::size_t i) { ordered[i] = prims[t.order[i]]; });
   prims = {};
   if (!uvs.empty()) {
     h.uvs.resize(uvs.size());
