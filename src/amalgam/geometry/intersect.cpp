@@ -82,32 +82,12 @@ std::optional<SurfaceHit> intersect_triangle(const Ray& ray, Vec3 a, Vec3 b, Vec
   return triangle_finish(ray, a, b, c, h);
 }
 
-Vec3 triangle_normal(Vec3 a, Vec3 b, Vec3 c) {
-  Vec3 n = cross(b - a, c - a);
-  const float l2 = dot(n, n);
-  if (!(l2 > 0x1.0p-100f && l2 < 0x1.0p100f)) [[unlikely]] {
-    // The squared length overflows for edges beyond about 1e12 and underflows below about
-    // 1e-13: the normal in double precision instead.
-    const double ex = double(b.x) - a.x, ey = double(b.y) - a.y, ez = double(b.z) - a.z;
-    const double fx = double(c.x) - a.x, fy = double(c.y) - a.y, fz = double(c.z) - a.z;
-    const double nx = ey * fz - ez * fy, ny = ez * fx - ex * fz, nz = ex * fy - ey * fx;
-    const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
-    n = len > 0.0 ? Vec3{float(nx / len), float(ny / len), float(nz / len)} : Vec3{};
-  } else {
-    n = normalize(n);
-  }
-  return n;
-}
-
-SurfaceHit triangle_finish(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, const TriangleCandidate& h) {
-  Vec3 n = triangle_normal(a, b, c);
-  if (dot(n, ray.dir) > 0) n = -n;
-  // Barycentric reconstruction: the error depends on the vertices, not on the ray origin.
-  const float inv = 1.0f / h.det;
-  const float u = h.u, v = h.v, w = h.w;
-  const Vec3 p = a * (u * inv) + b * (v * inv) + c * (w * inv);
-  const Vec3 err = (abs(a * (u * inv)) + abs(b * (v * inv)) + abs(c * (w * inv))) * gamma(7);
-  return SurfaceHit{h.t, n, p, err, v * inv, w * inv};
+Vec3 detail::triangle_normal_double(Vec3 a, Vec3 b, Vec3 c) {
+  const double ex = double(b.x) - a.x, ey = double(b.y) - a.y, ez = double(b.z) - a.z;
+  const double fx = double(c.x) - a.x, fy = double(c.y) - a.y, fz = double(c.z) - a.z;
+  const double nx = ey * fz - ez * fy, ny = ez * fx - ex * fz, nz = ex * fy - ey * fx;
+  const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+  return len > 0.0 ? Vec3{float(nx / len), float(ny / len), float(nz / len)} : Vec3{};
 }
 
 std::optional<SurfaceHit> intersect_sphere(const Ray& ray, Vec3 center, float radius) {

@@ -147,13 +147,36 @@ inline bool triangle_test(const Ray& ray, const TrianglePre& p, Vec3 a, Vec3 b, 
   return true;
 }
 
+namespace detail {
+/// `triangle_normal` in double precision (squared lengths beyond float's range).
+Vec3 triangle_normal_double(Vec3 a, Vec3 b, Vec3 c);
+}  // namespace detail
+
 /// The unit normal of triangle (a, b, c), (b - a) x (c - a) normalised (in double precision
 /// when its squared length would overflow or underflow in float); zero for a degenerate one.
-/// `triangle_finish` turns it to face the ray.
-Vec3 triangle_normal(Vec3 a, Vec3 b, Vec3 c);
+/// `triangle_finish` turns it to face the ray. Inline, with `triangle_finish`: once per ray's
+/// closest hit, where a call's argument spills and the square root's latency showed (issue 14).
+inline Vec3 triangle_normal(Vec3 a, Vec3 b, Vec3 c) {
+  const Vec3 n = cross(b - a, c - a);
+  const float l2 = dot(n, n);
+  // The squared length overflows for edges beyond about 1e12 and underflows below about 1e-13.
+  if (l2 > 0x1.0p-100f && l2 < 0x1.0p100f) [[likely]]
+    return n / std::sqrt(l2);
+  return detail::triangle_normal_double(a, b, c);
+}
 
 /// The full hit of a candidate from `triangle_test` on the same ray and triangle.
-SurfaceHit triangle_finish(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, const TriangleCandidate& h);
+inline SurfaceHit triangle_finish(const Ray& ray, Vec3 a, Vec3 b, Vec3 c,
+                                  const TriangleCandidate& h) {
+  Vec3 n = triangle_normal(a, b, c);
+  if (dot(n, ray.dir) > 0) n = -n;
+  // Barycentric reconstruction: the error depends on the vertices, not on the ray origin.
+  const float inv = 1.0f / h.det;
+  const float u = h.u, v = h.v, w = h.w;
+  const Vec3 p = a * (u * inv) + b * (v * inv) + c * (w * inv);
+  const Vec3 err = (abs(a * (u * inv)) + abs(b * (v * inv)) + abs(c * (w * inv))) * gamma(7);
+  return SurfaceHit{h.t, n, p, err, v * inv, w * inv};
+}
 
 /// Ray/sphere test with the numerically careful quadratic (Hearn & Baker form).
 std::optional<SurfaceHit> intersect_sphere(const Ray& ray, Vec3 center, float radius);

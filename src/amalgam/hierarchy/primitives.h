@@ -43,11 +43,16 @@ class PrimitiveStore {
     if (!packed_) return whole_[i];
     const std::uint32_t s = slot_[i];
     if (s & kWhole) return whole_[s & ~kWhole];
-    const TrianglePack4& p = packs_[s / kWideLanes];
-    const std::uint32_t l = s % kWideLanes;
-    return Primitive::triangle({p.v[0][0][l], p.v[0][1][l], p.v[0][2][l]},
-                               {p.v[1][0][l], p.v[1][1][l], p.v[1][2][l]},
-                               {p.v[2][0][l], p.v[2][1][l], p.v[2][2][l]}, material_[i]);
+    Primitive p{PrimKind::kTriangle, material_[i], {}, {}, {}, 0.0f};
+    from_pack(s, p.a, p.b, p.c);
+    return p;
+  }
+  /// The vertices of primitive `i`, a triangle, without the rest of its `Primitive`: the wide
+  /// walks' closest hit.
+  void triangle(std::size_t i, Vec3& a, Vec3& b, Vec3& c) const {
+    if (packed_ && !(slot_[i] & kWhole)) return from_pack(slot_[i], a, b, c);
+    const Primitive& p = packed_ ? whole_[slot_[i] & ~kWhole] : whole_[i];
+    a = p.a, b = p.b, c = p.c;
   }
   /// Primitive `i` by reference, for loops that read the whole form many times (the bake).
   /// Requires the whole form (`edit()` first).
@@ -82,6 +87,13 @@ class PrimitiveStore {
   }
 
  private:
+  void from_pack(std::uint32_t s, Vec3& a, Vec3& b, Vec3& c) const {
+    const TrianglePack4& p = packs_[s / kWideLanes];
+    const std::uint32_t l = s % kWideLanes;
+    a = {p.v[0][0][l], p.v[0][1][l], p.v[0][2][l]};
+    b = {p.v[1][0][l], p.v[1][1][l], p.v[1][2][l]};
+    c = {p.v[2][0][l], p.v[2][1][l], p.v[2][2][l]};
+  }
   static constexpr std::uint32_t kWhole = 0x80000000u;  ///< slot bit: index into whole_
   std::vector<Primitive> whole_;  ///< whole form: all; packed: those not in a pack
   std::size_t size_ = 0;          ///< packed: the number of ids

@@ -56,12 +56,13 @@ class InstancedWalk {
   static void finish(State& s) {
     const IH& h = s.h;
     const IH::InstanceData& in = h.instances[IH::slot(s.hit.id) - 1];
-    const Primitive p = h.meshes[in.mesh].prims[IH::local(s.hit.id)];
+    Vec3 a, b, c;
+    h.meshes[in.mesh].prims.triangle(IH::local(s.hit.id), a, b, c);
     if (in.identity) {
-      s.hit.surf = triangle_finish(s.ray, p.a, p.b, p.c, s.cand);
+      s.hit.surf = triangle_finish(s.ray, a, b, c, s.cand);
     } else {
       const Ray obj = IH::object_ray(in, s.ray);
-      s.hit.surf = IH::world_hit(in, triangle_finish(obj, p.a, p.b, p.c, s.cand), s.ray.dir);
+      s.hit.surf = IH::world_hit(in, triangle_finish(obj, a, b, c, s.cand), s.ray.dir);
     }
     s.pending = false;
   }

@@ -23,10 +23,11 @@ namespace amalgam {
 /// A hierarchy with SoA child boxes (hierarchy/wide.h) and directly addressable primitives:
 /// the traversal's fast path. `wide_nodes()` returns null when they are not built.
 template <class H>
-concept WideHierarchy = requires(const H& h, std::size_t i) {
+concept WideHierarchy = requires(const H& h, std::size_t i, Vec3& a) {
   { h.wide_nodes() } -> std::same_as<const WideNodes*>;
   { h.prims[i] } -> std::convertible_to<Primitive>;
   { h.prims.packs().data() } -> std::convertible_to<const TrianglePack4*>;
+  h.prims.triangle(i, a, a, a);
 };
 
 AMALGAM_ISA_BEGIN
@@ -108,8 +109,9 @@ class WideWalk {
 
   /// Builds the SurfaceHit of the closest hit when it is a deferred triangle.
   static void finish(State& s) {
-    const Primitive p = s.h.prims[s.hit.id];
-    s.hit.surf = triangle_finish(s.ray, p.a, p.b, p.c, s.cand);
+    Vec3 a, b, c;
+    s.h.prims.triangle(s.hit.id, a, b, c);
+    s.hit.surf = triangle_finish(s.ray, a, b, c, s.cand);
     s.pending = false;
   }
 
