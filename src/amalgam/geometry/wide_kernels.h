@@ -230,8 +230,9 @@ template <class L, BoxRays kRays>
 }
 
 template <class L, BoxRays kRays>
-inline unsigned box_test_lanes(const WideBox4* b, const WideRay& r, float tmin, float tmax, int n,
-                               float* t_entry) {
+[[gnu::always_inline]] inline unsigned box_test_lanes(const WideBox4* b, const WideRay& r,
+                                                      float tmin, float tmax, int n,
+                                                      float* t_entry) {
   using V = typename L::V;
   constexpr std::uint32_t kLo = 0, kHi = 3 * kWideLanes * sizeof(float);
   V lo[3], hi[3];
