@@ -317,9 +317,8 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
   return r;
 }
 
-}  // namespace
-
-void bake(ExplicitHierarchy& h, const BakeConfig& config) {
+/// Every node's appearance and `h.root_normals`, bottom-up, on the whole form of the primitives.
+void bake_appearances(ExplicitHierarchy& h, const BakeConfig& config) {
   const std::size_t n = h.nodes.size();
   // The whole form: the bake reads every primitive many times (build_wide packs them again).
   const std::vector<Primitive>& prims = h.prims.edit();
@@ -362,6 +361,14 @@ void bake(ExplicitHierarchy& h, const BakeConfig& config) {
   };
   for_each_level_bottom_up(level, config.parallel, bake_one);
   h.root_normals = n ? tensors[0] : NormalTensor{};
+}
+
+}  // namespace
+
+void bake(ExplicitHierarchy& h, const BakeConfig& config) {
+  bake_appearances(h, config);
+  // After the bake's per-node temporaries are freed: the packing briefly holds the whole
+  // primitives, the packs and the slots at once (the build's peak).
   build_wide(h);
 }
 
