@@ -8,12 +8,13 @@
 
 namespace amalgam {
 
-/// Calls f(i) for every i in [0, n): serially below `serial_below` items, else over oneTBB in
-/// chunks of `grain`. f must be safe to call concurrently for different i.
+/// Calls f(i) for every i in [0, n): serially below `serial_below` items or when not
+/// `parallel`, else over oneTBB in chunks of `grain`. f must be safe to call concurrently for
+/// different i.
 template <class F>
 void for_each_index(std::size_t n, F&& f, std::size_t serial_below = 16384,
-                    std::size_t grain = 4096) {
-  if (n < serial_below) {
+                    std::size_t grain = 4096, bool parallel = true) {
+  if (!parallel || n < serial_below) {
     for (std::size_t i = 0; i < n; ++i) f(i);
     return;
   }

@@ -1,13 +1,11 @@
 #include "amalgam/hierarchy/build/build.h"
 
-#include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/parallel_for.h>
-
 #include <algorithm>
 #include <chrono>
 
 #include "amalgam/hierarchy/build/sah.h"
 #include "amalgam/util/check.h"
+#include "amalgam/util/parallel.h"
 
 namespace amalgam {
 namespace {
@@ -57,15 +55,7 @@ ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surfa
   h.materials = std::move(materials);
   if (h.materials.empty()) h.materials.push_back(Surface{});
   std::vector<Bbox> boxes(prims.size());
-  auto each = [&](std::size_t n, auto&& f) {
-    if (config.parallel && n > 65536)
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384),
-                        [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t i = r.begin(); i < r.end(); ++i) f(i);
-                        });
-    else
-      for (std::size_t i = 0; i < n; ++i) f(i);
-  };
+  auto each = [&](std::size_t n, auto&& f) { for_each_index(n, f, 65537, 16384, config.parallel); };
   each(prims.size(), [&](std::size_t i) { boxes[i] = bounds(prims[i]); });
   SahTree t = build_sah(std::move(boxes), sah_config(config));
   std::vector<Primitive>& ordered = h.prims.edit();

@@ -1,7 +1,6 @@
 #include "amalgam/hierarchy/build/sah.h"
 
 #include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/parallel_invoke.h>
 #include <oneapi/tbb/parallel_reduce.h>
 
@@ -17,6 +16,7 @@
 
 #include "amalgam/hierarchy/hierarchy.h"
 #include "amalgam/util/check.h"
+#include "amalgam/util/parallel.h"
 
 namespace amalgam {
 
@@ -370,15 +370,7 @@ class BinaryBuilder {
 SahTree collapse(const BinaryBuilder& b, std::size_t items, const SahConfig& config) {
   const BinaryNode* bin = b.nodes_.get();
   const auto arity = static_cast<std::size_t>(std::clamp(config.arity, 2, kMaxChildren));
-  auto each = [&](std::size_t n, auto&& f) {
-    if (config.parallel && n >= 4096)
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
-                        [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t j = r.begin(); j < r.end(); ++j) f(j);
-                        });
-    else
-      for (std::size_t j = 0; j < n; ++j) f(j);
-  };
+  auto each = [&](std::size_t n, auto&& f) { for_each_index(n, f, 4096, 1024, config.parallel); };
 
   // Collapse breadth-first: open the child with the largest surface area until a node has
   // `arity` children (or only leaves are left). One level at a time: its nodes are opened in
