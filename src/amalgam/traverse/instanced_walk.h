@@ -178,28 +178,19 @@ class InstancedWalk {
   template <class Test, class Make>
   [[gnu::always_inline]] Next children(StackItem& it, StackItem*& st, std::size_t& cap,
                                        std::size_t& sp, int count, Test&& test, Make&& make) {
-    if (sp + static_cast<std::size_t>(count) > cap) {
-      stack_.resize(2 * cap + static_cast<std::size_t>(count));
-      st = stack_.data(), cap = stack_.size();
-    }
+    reserve_stack(stack_, st, cap, sp + static_cast<std::size_t>(count));
     const std::size_t base = sp;
     for (int c0 = 0; c0 < count; c0 += kChunk) {
       alignas(32) float t[kChunk];
-      for (unsigned mask = test(c0, std::min(count - c0, kChunk), t); mask; mask &= mask - 1) {
-        const int lane = std::countr_zero(mask);
-        const float te = t[lane];  // never NaN: a NaN entry fails the kernel's t0 <= t1
-        std::size_t i = sp++;
-        while (i > base && st[i - 1].t <= te) st[i] = st[i - 1], --i;
-        st[i] = make(c0 + lane);
-        st[i].t = te;
-      }
+      push_sorted(st, sp, base, test(c0, std::min(count - c0, kChunk), t), t,
+                  [&](int lane) { return make(c0 + lane); });
     }
     if (sp == base) return Next::kPop;
     it = st[--sp];
     return Next::kEnter;
   }
 
-  /// `boxes` on the world boxes of the transformed object boxes of instance `in` in the
+  /// `box_test_blocks` on the world boxes of the transformed object boxes of instance `in` in the
   /// blocks at `blk` (`InstancedHierarchy::world_box` of each).
   template <BoxRays kRays>
   [[gnu::always_inline]] static unsigned world_boxes(const IH::InstanceData& in,

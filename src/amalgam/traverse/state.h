@@ -9,6 +9,7 @@
 /// volume.
 
 #include <algorithm>
+#include <bit>
 #include <cstddef>
 #include <type_traits>
 #include <utility>
@@ -177,6 +178,34 @@ struct RayState {
     }
   }
 };
+
+/// A fast walk's stack `stack`, whose base `st` and capacity `cap` the walk keeps as locals
+/// (members would be reloaded after every store to the stack): grown to hold `need` items.
+template <class Item>
+[[gnu::always_inline]] inline void reserve_stack(std::vector<Item>& stack, Item*& st,
+                                                 std::size_t& cap, std::size_t need) {
+  if (need <= cap) return;
+  stack.resize(2 * cap + need);
+  st = stack.data(), cap = stack.size();
+}
+
+/// Pushes the hit lanes `mask` of a node's box test (entered at `t[lane]`; `make(lane)` is the
+/// child's item, its t set here) onto the stack `st` above `base`, insertion-sorted farthest
+/// first (the nearest is popped first). A later child (stored order) goes below the hits with
+/// equal t, so that among equals the first in stored order is popped first, as the recursion
+/// enters them (stable sort). Both fast walks push this way.
+template <class Item, class Make>
+[[gnu::always_inline]] inline void push_sorted(Item* st, std::size_t& sp, std::size_t base,
+                                               unsigned mask, const float* t, Make&& make) {
+  for (; mask; mask &= mask - 1) {
+    const int lane = std::countr_zero(mask);
+    const float te = t[lane];  // never NaN: a NaN entry fails the kernel's t0 <= t1
+    std::size_t i = sp++;
+    while (i > base && st[i - 1].t <= te) st[i] = st[i - 1], --i;
+    st[i] = make(lane);
+    st[i].t = te;
+  }
+}
 
 AMALGAM_ISA_END
 }  // namespace amalgam

@@ -256,27 +256,19 @@ class WideWalk {
     return Next::kEnter;
   }
 
-  /// Grows the stack to hold `need` items (the base and capacity are the loop's locals).
+  /// Grows the stack to hold `need` items (state.h, `reserve_stack`).
   [[gnu::always_inline]] void reserve(StackItem*& st, std::size_t& cap, std::size_t need) {
-    if (need <= cap) return;
-    stack_.resize(2 * cap + need);
-    st = stack_.data(), cap = stack_.size();
+    reserve_stack(stack_, st, cap, need);
   }
 
-  /// Pushes the lanes of `mask` (children `first + lane`, entered at `t[lane]`) onto the stack
-  /// above `base`, insertion-sorted farthest first (the nearest is popped first). A later
-  /// child (stored order) goes below the hits with equal t, so that among equals the first in
-  /// stored order is popped first, as the recursion enters them (stable sort).
+  /// Pushes the lanes of `mask` (children `first + lane`, entered at `t[lane]`) above `base`
+  /// (state.h, `push_sorted`).
   [[gnu::always_inline]] static void push_sorted(StackItem* st, std::size_t& sp, unsigned mask,
                                                  const float* t, std::uint32_t first, int level,
                                                  std::size_t base) {
-    for (; mask; mask &= mask - 1) {
-      const int lane = std::countr_zero(mask);
-      const float te = t[lane];  // never NaN: a NaN entry fails the kernel's t0 <= t1
-      std::size_t i = sp++;
-      while (i > base && st[i - 1].t <= te) st[i] = st[i - 1], --i;
-      st[i] = {te, first + static_cast<std::uint32_t>(lane), level};
-    }
+    amalgam::push_sorted(st, sp, base, mask, t, [&](int lane) {
+      return StackItem{0, first + static_cast<std::uint32_t>(lane), level};
+    });
   }
 
   /// One primitive of a mixed leaf: triangles with the per-ray setup and a deferred
