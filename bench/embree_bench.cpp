@@ -42,6 +42,7 @@
 #include <random>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "amalgam/hierarchy/bake/bake.h"
@@ -129,7 +130,7 @@ struct EmbreeScene {
   MemoryMonitor monitor;
 
   explicit EmbreeScene(const std::vector<Primitive>& prims) {
-    device = rtcNewDevice(nullptr);
+    device = rtcNewDevice(std::getenv("AMALGAM_EMBREE_CONFIG"));
     rtcSetDeviceErrorFunction(device, embree_error, nullptr);
     rtcSetDeviceMemoryMonitorFunction(device, &MemoryMonitor::callback, &monitor);
     vertices.reserve(prims.size() * 9 + 1);
@@ -398,6 +399,8 @@ void bm_rays(benchmark::State& state, SceneSpec spec, RayKindB kind, int threads
   const std::size_t n = set.ours.size();
   std::atomic<std::uint64_t> sink{0};
 
+  // The counted pass's totals (nodes reached, box and primitive tests: the work per ray).
+  std::atomic<std::uint64_t> reached{0}, box_tests{0}, prim_tests{0};
   auto ours_with = [&]<class Tr, class Stats>(std::size_t b, std::size_t e) {
     Stats stats;
     Tr tr(sc.ours, TraditionalLod{}, stats);
@@ -409,6 +412,12 @@ void bm_rays(benchmark::State& state, SceneSpec spec, RayKindB kind, int threads
         hits += tr.intersect(set.ours[i], i).kind != TraceHit::Kind::kNone;
     }
     sink += hits;
+    if constexpr (std::is_same_v<Stats, Counters>) {
+      reached += stats.reached[0] + stats.reached[1];
+      box_tests +=
+          stats.tests_of(ObjectKind::kBoundingVolume) + stats.tests_of(ObjectKind::kAmalgam);
+      prim_tests += stats.tests_of(ObjectKind::kPrimitive);
+    }
   };
   auto ours = [&](std::size_t b, std::size_t e) {
     ours_with.template operator()<OurTraversal, NullCounters>(b, e);
@@ -436,16 +445,23 @@ void bm_rays(benchmark::State& state, SceneSpec spec, RayKindB kind, int threads
   // Ours, Embree, ours counted, Embree robust: each of our passes follows one of Embree's (on
   // the large scenes the caches then hold the other structure), as each of Embree's follows
   // one of ours.
+  // AMALGAM_BENCH_ONLY=ours|embree|counted|robust runs that pass alone, to profile one side
+  // with perf or callgrind (the ratios are then meaningless).
+  const char* only_env = std::getenv("AMALGAM_BENCH_ONLY");
+  const std::string only = only_env ? only_env : "";
+  auto pass = [&](const char* name, const auto& body) {
+    if (only.empty() || only == name) run_split(arena.get(), n, body);
+  };
   double t_ours = 0, t_embree = 0, t_robust = 0, t_counted = 0;
   for (auto _ : state) {
     const auto t0 = Clock::now();
-    run_split(arena.get(), n, ours);
+    pass("ours", ours);
     const auto t1 = Clock::now();
-    run_split(arena.get(), n, embree);
+    pass("embree", embree);
     const auto t2 = Clock::now();
-    run_split(arena.get(), n, counted);
+    pass("counted", counted);
     const auto t3 = Clock::now();
-    run_split(arena.get(), n, robust);
+    pass("robust", robust);
     const auto t4 = Clock::now();
     t_ours += std::chrono::duration<double>(t1 - t0).count();
     t_embree += std::chrono::duration<double>(t2 - t1).count();
@@ -463,6 +479,11 @@ void bm_rays(benchmark::State& state, SceneSpec spec, RayKindB kind, int threads
   state.counters["counted_ratio"] = t_ours / t_counted;
   state.counters["speed_ratio_robust"] = m_ours / m_robust;
   state.counters["rays"] = static_cast<double>(n);
+  if (t_counted > 0) {
+    state.counters["nodes_per_ray"] = static_cast<double>(reached.load()) / rays;
+    state.counters["box_tests_per_ray"] = static_cast<double>(box_tests.load()) / rays;
+    state.counters["prim_tests_per_ray"] = static_cast<double>(prim_tests.load()) / rays;
+  }
   state.counters["threads"] = threads;
   state.counters["triangles"] = static_cast<double>(sc.prims.size());
   state.counters["ours_Mrays_s"] = m_ours;
