@@ -135,18 +135,20 @@ std::uint32_t bits(float f) {
 }
 
 /// The box kernel on `lanes` boxes (4: the portable copy; 8: the AVX2 copy's kernel over two
-/// blocks) against the scalar test: same hit mask and the same entry t, bit for bit.
+/// blocks) against the scalar test: same hit mask and the same entry t, bit for bit, in both
+/// of its modes (kNonZero only for the rays `box_rays_simple` admits).
 void check_box_kernel(int lanes) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(-2.0f, 2.0f);
-  int hits = 0;
+  int hits = 0, simple_rays = 0;
   for (int i = 0; i < 20000; ++i) {
     WideBox4 blk[2];
     Bbox boxes[2 * kWideLanes];
     for (int lane = 0; lane < lanes; ++lane) {
-      // Some degenerate (flat) boxes and some sharing a plane with the ray origin.
+      // Some degenerate (flat) boxes, some sharing a plane with the ray origin, some empty.
       boxes[lane] = Bbox::of({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
       if (i % 5 == 0) boxes[lane].hi.y = boxes[lane].lo.y;
+      if (i % 11 == 0 && lane == 1) boxes[lane] = Bbox{};
       WideBox4& b = blk[lane / kWideLanes];
       for (int a = 0; a < 3; ++a)
         b.lo[a][lane % kWideLanes] = boxes[lane].lo[a],
@@ -154,26 +156,37 @@ void check_box_kernel(int lanes) {
     }
     Vec3 o{u(rng), u(rng), u(rng)}, d{u(rng), u(rng), u(rng)};
     if (i % 3 == 0) d[i % 2] = 0.0f;
+    if (i % 13 == 0) d.z = i % 2 ? 1e-40f : -0.0f;  // an infinite inverse; a negative zero
     if (i % 7 == 0) o.x = boxes[0].lo.x;
+    if (i % 17 == 0) o.y = boxes[0].hi.y;
     Ray ray = Ray::make(o, d, i % 4 == 0 ? 0.5f : 0.0f, i % 6 == 0 ? 1.0f : kInfinity);
-    float t[2 * kWideLanes];
-    unsigned m;
+    const bool simple = box_rays_simple(ray);
+    simple_rays += simple;
+    for (const bool fast : {false, true}) {
+      if (fast && !simple) continue;
+      float t[2 * kWideLanes];
+      unsigned m;
 #if defined(AMALGAM_BUILD_AVX2_COPY)
-    if (lanes > kWideLanes)
-      m = test::avx2_box_test8(blk, ray, lanes, t);
-    else
+      if (lanes > kWideLanes)
+        m = test::avx2_box_test8(blk, ray, lanes, t, fast);
+      else
 #endif
-      m = intersect_wide4(blk[0], WideRay::of(ray), ray.tmin, ray.tmax, lanes, t);
-    for (int lane = 0; lane < lanes; ++lane) {
-      const auto s = intersect_box(ray, boxes[lane]);
-      ASSERT_EQ(((m >> lane) & 1u) != 0, s.has_value()) << "case " << i << " lane " << lane;
-      if (s) {
-        EXPECT_EQ(bits(t[lane]), bits(s->t0)) << "case " << i << " lane " << lane;
-        ++hits;
+        m = fast ? intersect_wide4<false>(blk[0], WideRay::of(ray), ray.tmin, ray.tmax, lanes, t)
+                 : intersect_wide4(blk[0], WideRay::of(ray), ray.tmin, ray.tmax, lanes, t);
+      for (int lane = 0; lane < lanes; ++lane) {
+        const auto s = intersect_box(ray, boxes[lane]);
+        ASSERT_EQ(((m >> lane) & 1u) != 0, s.has_value())
+            << "case " << i << " lane " << lane << " simple " << fast;
+        if (s) {
+          EXPECT_EQ(bits(t[lane]), bits(s->t0)) << "case " << i << " lane " << lane;
+          hits += !fast;
+        }
       }
     }
   }
   EXPECT_GT(hits, 250 * lanes);
+  EXPECT_GT(simple_rays, 10000);
+  EXPECT_LT(simple_rays, 15000);
 }
 
 TEST(SimdTraversal, WideBoxKernelMatchesScalarBoxTest) {

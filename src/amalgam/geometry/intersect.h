@@ -65,7 +65,7 @@ std::optional<SurfaceHit> intersect_triangle(const Ray& ray, Vec3 a, Vec3 b, Vec
 struct TrianglePre {
   int kx, ky, kz;
   float sx, sy, sz;
-  static TrianglePre of(const Ray& ray) {
+  [[gnu::always_inline]] static TrianglePre of(const Ray& ray) {
     const Vec3 ad = abs(ray.dir);
     TrianglePre p;
     p.kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);

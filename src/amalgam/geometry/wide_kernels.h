@@ -13,6 +13,8 @@
 /// first to include it there.
 
 #include <bit>
+#include <cmath>
+#include <cstdint>
 
 #include "amalgam/geometry/intersect.h"
 #include "amalgam/geometry/wide.h"
@@ -25,8 +27,7 @@ AMALGAM_ISA_BEGIN
 struct WideRay {
   float o[3];
   float inv[3];
-  bool zero[3];  ///< dir[axis] == 0: the axis is a containment test (as in intersect_box)
-  bool any_zero;
+  bool zero[3];     ///< dir[axis] == 0: the axis is a containment test (as in intersect_box)
   TrianglePre pre;  ///< the watertight triangle test's setup (TrianglePre::of)
 #if AMALGAM_WIDE_SSE
   // Broadcast once per ray, so the kernels read them as memory operands instead of
@@ -42,7 +43,7 @@ struct WideRay {
   __m128 shear4[3], ok4[3];  ///< as shear8, ok8
 #endif
 #endif
-  static WideRay of(const Ray& r) {
+  [[gnu::always_inline]] static WideRay of(const Ray& r) {
     WideRay w;
     for (int a = 0; a < 3; ++a) {
       w.o[a] = r.origin[a], w.inv[a] = r.inv_dir[a], w.zero[a] = r.dir[a] == 0.0f;
@@ -54,7 +55,6 @@ struct WideRay {
 #endif
 #endif
     }
-    w.any_zero = w.zero[0] || w.zero[1] || w.zero[2];
     w.pre = TrianglePre::of(r);
 #if AMALGAM_WIDE_SSE
 #if defined(AMALGAM_ISA_AVX2)
@@ -178,10 +178,21 @@ struct Lanes8 {
 #endif
 #endif
 
-/// How the box kernel may treat a ray's axes: kZeroAxes, a direction component may be zero
-/// (that axis is a containment test, as in intersect_box); kNonZero, none is (`!r.any_zero`),
-/// so the per-axis branch of that case is left out.
+/// How the box kernel may treat a ray: kZeroAxes, any ray (a zero direction component makes
+/// that axis a containment test, as in intersect_box); kNonZero, a ray for which
+/// `box_rays_simple` holds, so that no slab distance can be NaN: the per-axis branch and the
+/// infinite starting values of the interval are left out (the same floats without them).
 enum class BoxRays { kZeroAxes, kNonZero };
+
+/// Whether `r` may take the kNonZero kernels: a finite origin and a finite inverse of every
+/// direction component (so no zero component either). Then (plane - o) * inv is never NaN
+/// for a box's planes, which are never NaN.
+[[gnu::always_inline]] inline bool box_rays_simple(const Ray& r) {
+  for (int a = 0; a < 3; ++a)
+    if (!(std::fabs(r.origin[a]) < kInfinity) || !(std::fabs(r.inv_dir[a]) < kInfinity))
+      return false;
+  return true;
+}
 
 #if AMALGAM_WIDE_SSE
 
@@ -203,11 +214,12 @@ template <class L, BoxRays kRays>
                                                         float* t_entry) {
   using V = typename L::V;
   constexpr float kGrow = 1.0f + 2.0f * gamma(3);
-  V t_near = L::set1(-kInfinity), t_far = L::set1(kInfinity);
+  V t_near, t_far;
   V ok = L::all();
   for (int a = 0; a < 3; ++a) {
     const V o = L::origin(r, a);
     if (kRays == BoxRays::kZeroAxes && r.zero[a]) {  // scalar: if (o < lo || o > hi) miss
+      if (a == 0) t_near = L::set1(-kInfinity), t_far = L::set1(kInfinity);
       ok = L::band(ok, L::band(L::nlt(o, lo[a]), L::ngt(o, hi[a])));
       continue;
     }
@@ -217,6 +229,13 @@ template <class L, BoxRays kRays>
     // scalar: if (t0 > t1) swap. minps(x, y) = x < y ? x : y; maxps(x, y) = x > y ? x : y.
     const V tn = L::min(t1, t0);
     const V tf = L::max(t0, t1);
+    if (a == 0 && kRays == BoxRays::kNonZero) {
+      // No NaN (box_rays_simple): the scalar test's infinite starting values give way to the
+      // first axis's distances, bit for bit, so the interval starts there.
+      t_near = tn, t_far = tf;
+      continue;
+    }
+    if (a == 0) t_near = L::set1(-kInfinity), t_far = L::set1(kInfinity);
     t_near = L::max(tn, t_near);  // if (t0 > t_near) t_near = t0
     t_far = L::min(tf, t_far);    // if (t1 < t_far) t_far = t1
   }
@@ -245,8 +264,9 @@ template <class L, BoxRays kRays>
 #endif
 
 /// `box_test_lanes` on the first `n` (1..4) boxes of `b` (SSE; a scalar loop without SSE,
-/// where every mode is the scalar test). `kZeroAxes` false: the caller knows that `r` has no
-/// zero direction component (`!r.any_zero`), so the per-axis branch of that case is left out.
+/// where every mode is the scalar test). `kZeroAxes` false: the caller knows that
+/// `box_rays_simple` holds for `r` (finite origin and inverse direction), so the per-axis
+/// branch of a zero component and the NaN-skipping start are left out.
 template <bool kZeroAxes = true>
 inline unsigned intersect_wide4(const WideBox4& b, const WideRay& r, float tmin, float tmax, int n,
                                 float t_entry[kWideLanes]) {
@@ -305,8 +325,9 @@ using TrianglePackHits = TrianglePackHitsN<kWideLanes>;
 /// the closest hit among the lanes (a lane's tmax does not shrink by an earlier lane's hit
 /// here, unlike in a one-by-one loop).
 template <class L>
-inline unsigned triangle_test_lanes(const TrianglePack4* p, const WideRay& r, float tmin,
-                                    float tmax, int n, TrianglePackHitsN<L::kLanes>& out) {
+[[gnu::always_inline]] inline unsigned triangle_test_lanes(const TrianglePack4* p, const WideRay& r,
+                                                           float tmin, float tmax, int n,
+                                                           TrianglePackHitsN<L::kLanes>& out) {
   using V = typename L::V;
   constexpr int N = L::kLanes;
   const TrianglePre& pre = r.pre;
@@ -385,8 +406,9 @@ inline unsigned triangle_test_lanes(const TrianglePack4* p, const WideRay& r, fl
 
 /// `triangle_test` on the first `n` (1..4) triangles of `p` at once (SSE, `triangle_test_lanes`;
 /// a scalar loop without SSE).
-inline unsigned triangle_test4(const TrianglePack4& p, const WideRay& r, float tmin, float tmax,
-                               int n, TrianglePackHits& out) {
+[[gnu::always_inline]] inline unsigned triangle_test4(const TrianglePack4& p, const WideRay& r,
+                                                      float tmin, float tmax, int n,
+                                                      TrianglePackHits& out) {
 #if AMALGAM_WIDE_SSE
   return triangle_test_lanes<Lanes4>(&p, r, tmin, tmax, n, out);
 #else

@@ -44,11 +44,10 @@ class InstancedWalk {
   void run(State& s, const WideNodes& top, float t_root) {
     if (stack_.size() < 64) stack_.resize(64);
     obj_inst_ = 0;
-    const bool zero = s.ray.dir.x == 0.0f || s.ray.dir.y == 0.0f || s.ray.dir.z == 0.0f;
-    if (zero)
-      loop<BoxRays::kZeroAxes>(s, top, t_root);
-    else
+    if (box_rays_simple(s.ray))  // as WideWalk::run
       loop<BoxRays::kNonZero>(s, top, t_root);
+    else
+      loop<BoxRays::kZeroAxes>(s, top, t_root);
   }
 
   /// Builds the SurfaceHit of the closest hit when it is a deferred triangle: the generic

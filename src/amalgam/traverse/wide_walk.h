@@ -109,11 +109,12 @@ class WideWalk {
     if (stack_.size() < 64) stack_.resize(64);
     stack_[0] = {t_root, root, 0};
     // A ray with a zero direction component needs the box test's containment branch per
-    // axis; all others (nearly every ray) run a loop without those branches.
-    if (s.ray.dir.x == 0.0f || s.ray.dir.y == 0.0f || s.ray.dir.z == 0.0f)
-      loop<BoxRays::kZeroAxes>(s, w);
-    else
+    // axis, and one with an infinite origin or inverse direction its NaN-skipping start;
+    // all others (nearly every ray) run a loop without them.
+    if (box_rays_simple(s.ray))
       loop<BoxRays::kNonZero>(s, w);
+    else
+      loop<BoxRays::kZeroAxes>(s, w);
   }
 
   /// Builds the SurfaceHit of the closest hit when it is a deferred triangle.
@@ -144,7 +145,6 @@ class WideWalk {
     // The per-ray constants and the stack's base and capacity as locals: members would be
     // reloaded after every store to the stack (a float store may alias them).
     const WideRay wr = WideRay::of(s.ray);
-    tri_ = wr.pre;  // for the primitives of mixed leaves (`primitive`)
     const Arrays arr{w.headers.data(), w.blocks.data(), s.h.prims.packs().data()};
     StackItem* st = stack_.data();
     std::size_t cap = stack_.size(), sp = 0;
@@ -191,7 +191,7 @@ class WideWalk {
     if (hd.leaf == kWideLeaf) {
       for (int i = 0; i < count; ++i) {
         s.counters.count_test(s.kind, ObjectKind::kPrimitive, cl);
-        primitive(s, hd.first + static_cast<std::uint32_t>(i), cl);
+        primitive(s, wr.pre, hd.first + static_cast<std::uint32_t>(i), cl);
         if (s.done) return Next::kStop;
       }
       return Next::kPop;
@@ -273,18 +273,17 @@ class WideWalk {
 
   /// One primitive of a mixed leaf: triangles with the per-ray setup and a deferred
   /// SurfaceHit; other kinds through the full kernel (as ExplicitHierarchy::intersect).
-  void primitive(State& s, std::uint32_t id, int level) {
+  static void primitive(State& s, const TrianglePre& pre, std::uint32_t id, int level) {
     const Primitive p = s.h.prims[id];
     if (p.kind == PrimKind::kTriangle) {
       TriangleCandidate c;
-      if (triangle_test(s.ray, tri_, p.a, p.b, p.c, c)) s.on_triangle(id, level, c);
+      if (triangle_test(s.ray, pre, p.a, p.b, p.c, c)) s.on_triangle(id, level, c);
       return;
     }
     if (auto hit = amalgam::intersect(p, s.ray)) s.on_primitive(id, level, *hit);
   }
 
   std::vector<StackItem> stack_;
-  TrianglePre tri_{};
 };
 
 AMALGAM_ISA_END
