@@ -77,7 +77,9 @@ struct RayState {
     any_hit = shadow;
     done = false;
     pending = false;
-    hit = TraceHit{};
+    // A shadow ray never writes or returns `hit` (an opaque thing occludes it): only a
+    // closest-hit ray starts from an empty one (a fifth of a short shadow ray's entry).
+    if (!shadow) hit = TraceHit{};
     transmittance = 1.0f;
     counters.count_ray(rk);
   }
