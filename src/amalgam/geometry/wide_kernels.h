@@ -214,12 +214,11 @@ template <class L, BoxRays kRays>
                                                         float* t_entry) {
   using V = typename L::V;
   constexpr float kGrow = 1.0f + 2.0f * gamma(3);
-  V t_near, t_far;
+  V t_near = L::set1(-kInfinity), t_far = L::set1(kInfinity);
   V ok = L::all();
   for (int a = 0; a < 3; ++a) {
     const V o = L::origin(r, a);
     if (kRays == BoxRays::kZeroAxes && r.zero[a]) {  // scalar: if (o < lo || o > hi) miss
-      if (a == 0) t_near = L::set1(-kInfinity), t_far = L::set1(kInfinity);
       ok = L::band(ok, L::band(L::nlt(o, lo[a]), L::ngt(o, hi[a])));
       continue;
     }
@@ -231,11 +230,11 @@ template <class L, BoxRays kRays>
     const V tf = L::max(t0, t1);
     if (a == 0 && kRays == BoxRays::kNonZero) {
       // No NaN (box_rays_simple): the scalar test's infinite starting values give way to the
-      // first axis's distances, bit for bit, so the interval starts there.
+      // first axis's distances, bit for bit, so the interval starts there (the compiler drops
+      // the unused starting values).
       t_near = tn, t_far = tf;
       continue;
     }
-    if (a == 0) t_near = L::set1(-kInfinity), t_far = L::set1(kInfinity);
     t_near = L::max(tn, t_near);  // if (t0 > t_near) t_near = t0
     t_far = L::min(tf, t_far);    // if (t1 < t_far) t_far = t1
   }
