@@ -68,14 +68,16 @@ void expect_same(const ExplicitHierarchy& a, const ExplicitHierarchy& b) {
   }
   EXPECT_EQ(std::memcmp(&a.root_normals, &b.root_normals, sizeof(NormalTensor)), 0);
   ASSERT_EQ(a.wide.headers.size(), b.wide.headers.size());
-  ASSERT_EQ(a.wide.blocks.size(), b.wide.blocks.size());
+  ASSERT_EQ(a.wide.pool.size(), b.wide.pool.size());
   ASSERT_EQ(a.prims.packs().size(), b.prims.packs().size());
   EXPECT_EQ(std::memcmp(a.wide.headers.data(), b.wide.headers.data(),
                         a.wide.headers.size() * sizeof(WideHeader)),
             0);
-  EXPECT_EQ(std::memcmp(a.wide.blocks.data(), b.wide.blocks.data(),
-                        a.wide.blocks.size() * sizeof(WideBox4)),
-            0);
+  EXPECT_EQ(
+      std::memcmp(a.wide.pool.data(), b.wide.pool.data(), a.wide.pool.size() * sizeof(WideUnit)),
+      0);
+  EXPECT_EQ(a.wide.record_node, b.wide.record_node);
+  EXPECT_EQ(a.wide.root, b.wide.root);
   EXPECT_EQ(std::memcmp(a.prims.packs().data(), b.prims.packs().data(),
                         a.prims.packs().size() * sizeof(TrianglePack4)),
             0);

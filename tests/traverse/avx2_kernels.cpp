@@ -27,10 +27,11 @@ unsigned avx2_triangle_test8(const TrianglePack4 p[2], const Ray& ray, float tmi
   return mask;
 }
 
-unsigned avx2_box_test8(const WideBox4 b[2], const Ray& ray, int n, float t_entry[8], bool simple) {
+unsigned avx2_box_test8(BoxRows b, const Ray& ray, int n, float t_entry[8], bool simple) {
   const WideRay wr = WideRay::of(ray);
-  return simple ? box_test_lanes<Lanes8, BoxRays::kNonZero>(b, wr, ray.tmin, ray.tmax, n, t_entry)
-                : box_test_lanes<Lanes8, BoxRays::kZeroAxes>(b, wr, ray.tmin, ray.tmax, n, t_entry);
+  return simple
+             ? box_test_lanes<Lanes8, BoxRays::kNonZero>(b, 0, wr, ray.tmin, ray.tmax, n, t_entry)
+             : box_test_lanes<Lanes8, BoxRays::kZeroAxes>(b, 0, wr, ray.tmin, ray.tmax, n, t_entry);
 }
 
 }  // namespace amalgam::test

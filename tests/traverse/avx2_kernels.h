@@ -13,9 +13,9 @@ namespace amalgam::test {
 unsigned avx2_triangle_test8(const TrianglePack4 p[2], const Ray& ray, float tmin, float tmax,
                              int n, float out[5][8]);
 
-/// `box_test_lanes<Lanes8, mode>` on the blocks b[0], b[1] (first `n` lanes) against `ray`
-/// over [ray.tmin, ray.tmax]: the hit mask, entry t per lane. Mode kNonZero if `simple` (the
-/// caller checked `box_rays_simple`), else kZeroAxes.
-unsigned avx2_box_test8(const WideBox4 b[2], const Ray& ray, int n, float t_entry[8], bool simple);
+/// `box_test_lanes<Lanes8, mode>` on the rows `b` (first `n` lanes) against `ray` over
+/// [ray.tmin, ray.tmax]: the hit mask, entry t per lane. Mode kNonZero if `simple` (the caller
+/// checked `box_rays_simple`), else kZeroAxes.
+unsigned avx2_box_test8(BoxRows b, const Ray& ray, int n, float t_entry[8], bool simple);
 
 }  // namespace amalgam::test

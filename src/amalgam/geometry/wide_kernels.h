@@ -12,6 +12,7 @@
 /// (traverse/, render/), never from a lower layer, so that the AVX2 translation unit is the
 /// first to include it there.
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -72,21 +73,17 @@ struct WideRay {
 };
 
 #if AMALGAM_WIDE_SSE
-/// The vector operations of the box and triangle kernels: 4 lanes (SSE) from one block or
-/// pack...
+/// The vector operations of the box and triangle kernels: 4 lanes (SSE) from half a box block
+/// or one pack...
 struct Lanes4 {
   using V = __m128;
   static constexpr int kLanes = 4;
-  /// The floats at `byte_offset` in block `b` (a WideBox4's lo or hi of one axis).
-  static V load(const WideBox4* b, std::uint32_t byte_offset) {
-    return _mm_load_ps(
-        reinterpret_cast<const float*>(reinterpret_cast<const char*>(b) + byte_offset));
-  }
   /// One coordinate of one vertex of the triangles of pack `p`.
   static V load(const TrianglePack4* p, int vertex, int axis) {
     return _mm_load_ps(p[0].v[vertex][axis]);
   }
   static V load_aligned(const float* d) { return _mm_load_ps(d); }
+  static V load(const float* d) { return _mm_loadu_ps(d); }
   static V set1(float x) { return _mm_set1_ps(x); }
   static V zero() { return _mm_setzero_ps(); }
   static V all() { return _mm_castsi128_ps(_mm_set1_epi32(-1)); }
@@ -137,18 +134,16 @@ struct Lanes4 {
 #endif
 };
 #if defined(AMALGAM_ISA_AVX2)
-/// ... or 8 lanes (AVX) from two consecutive blocks or packs. Without FMA (the build does not
-/// enable it), each lane performs exactly the SSE form's operations.
+/// ... or 8 lanes (AVX) from one box block or two consecutive packs. Without FMA (the build does
+/// not enable it), each lane performs exactly the SSE form's operations.
 struct Lanes8 {
   using V = __m256;
   static constexpr int kLanes = 8;
-  static V load(const WideBox4* b, std::uint32_t byte_offset) {
-    return _mm256_set_m128(Lanes4::load(b + 1, byte_offset), Lanes4::load(b, byte_offset));
-  }
   static V load(const TrianglePack4* p, int vertex, int axis) {
     return _mm256_set_m128(_mm_load_ps(p[1].v[vertex][axis]), _mm_load_ps(p[0].v[vertex][axis]));
   }
   static V load_aligned(const float* d) { return _mm256_load_ps(d); }
+  static V load(const float* d) { return _mm256_loadu_ps(d); }
   static V set1(float x) { return _mm256_set1_ps(x); }
   static V zero() { return _mm256_setzero_ps(); }
   static V all() { return _mm256_castsi256_ps(_mm256_set1_epi32(-1)); }
@@ -247,35 +242,38 @@ template <class L, BoxRays kRays>
   return L::mask(ok) & ((1u << n) - 1u);
 }
 
+/// `box_test_vectors` on lanes c0 .. c0 + L::kLanes - 1 of the rows `b` (c0: 0, or 4 for the
+/// upper half of 8-lane rows in SSE), the first `n` of them. An 8-lane read of 4-lane rows
+/// takes the next row's floats into its upper lanes: n <= 4 masks them off.
 template <class L, BoxRays kRays>
-[[gnu::always_inline]] inline unsigned box_test_lanes(const WideBox4* b, const WideRay& r,
+[[gnu::always_inline]] inline unsigned box_test_lanes(BoxRows b, int c0, const WideRay& r,
                                                       float tmin, float tmax, int n,
                                                       float* t_entry) {
   using V = typename L::V;
-  constexpr std::uint32_t kLo = 0, kHi = 3 * kWideLanes * sizeof(float);
   V lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) {
-    const std::uint32_t axis = static_cast<std::uint32_t>(a * kWideLanes * sizeof(float));
-    lo[a] = L::load(b, kLo + axis), hi[a] = L::load(b, kHi + axis);
-  }
+  for (int a = 0; a < 3; ++a)
+    lo[a] = L::load(b.rows + a * b.stride + c0), hi[a] = L::load(b.rows + (3 + a) * b.stride + c0);
   return box_test_vectors<L, kRays>(lo, hi, r, tmin, tmax, n, t_entry);
 }
 #endif
 
-/// `box_test_lanes` on the first `n` (1..4) boxes of `b` (SSE; a scalar loop without SSE,
-/// where every mode is the scalar test). `kZeroAxes` false: the caller knows that
-/// `box_rays_simple` holds for `r` (finite origin and inverse direction), so the per-axis
-/// branch of a zero component and the NaN-skipping start are left out.
+/// Boxes c0 .. c0 + n - 1 of the rows `b` (n <= 4; c0 a multiple of 4) against the ray: the
+/// 4-lane `box_test_lanes` (SSE; a scalar loop without SSE, where every mode is the scalar
+/// test). `kZeroAxes` false: the caller knows that `box_rays_simple` holds for `r` (finite
+/// origin and inverse direction), so the per-axis branch of a zero component and the
+/// NaN-skipping start are left out. Lane i of the mask and of `t_entry` is box c0 + i.
 template <bool kZeroAxes = true>
-inline unsigned intersect_wide4(const WideBox4& b, const WideRay& r, float tmin, float tmax, int n,
+inline unsigned intersect_wide4(BoxRows b, int c0, const WideRay& r, float tmin, float tmax, int n,
                                 float t_entry[kWideLanes]) {
 #if AMALGAM_WIDE_SSE
   return box_test_lanes < Lanes4,
-         kZeroAxes ? BoxRays::kZeroAxes : BoxRays::kNonZero > (&b, r, tmin, tmax, n, t_entry);
+         kZeroAxes ? BoxRays::kZeroAxes : BoxRays::kNonZero > (b, c0, r, tmin, tmax, n, t_entry);
 #else
   unsigned mask = 0;
   for (int i = 0; i < n; ++i) {
-    Bbox box{{b.lo[0][i], b.lo[1][i], b.lo[2][i]}, {b.hi[0][i], b.hi[1][i], b.hi[2][i]}};
+    Bbox box;
+    for (int a = 0; a < 3; ++a)
+      box.lo[a] = b.rows[a * b.stride + c0 + i], box.hi[a] = b.rows[(3 + a) * b.stride + c0 + i];
     Ray ray;
     ray.origin = {r.o[0], r.o[1], r.o[2]};
     ray.inv_dir = {r.inv[0], r.inv[1], r.inv[2]};
@@ -288,19 +286,21 @@ inline unsigned intersect_wide4(const WideBox4& b, const WideRay& r, float tmin,
 #endif
 }
 
-/// The first `m` boxes of the blocks at `blk` (m <= 8 in the AVX2 copy, two blocks; <= 4
-/// otherwise): one kernel call, the 8-lane one when more than four (a scalar loop without SSE,
-/// exact for any ray).
+/// The first `n` (<= the rows' stride) boxes of the rows `b`: one 8-lane kernel call in the
+/// AVX2 copy, one or two 4-lane ones otherwise (a scalar loop without SSE, exact for any ray).
+/// `t` holds 8 entries.
 template <BoxRays kRays>
-[[gnu::always_inline]] inline unsigned box_test_blocks(const WideBox4* blk, const WideRay& wr,
-                                                       float tmin, float tmax, int m, float* t) {
-#if AMALGAM_WIDE_SSE
-#if defined(AMALGAM_ISA_AVX2)
-  if (m > kWideLanes) return box_test_lanes<Lanes8, kRays>(blk, wr, tmin, tmax, m, t);
-#endif
-  return box_test_lanes<Lanes4, kRays>(blk, wr, tmin, tmax, m, t);
+[[gnu::always_inline]] inline unsigned box_test_block(BoxRows b, const WideRay& wr, float tmin,
+                                                      float tmax, int n, float* t) {
+#if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
+  return box_test_lanes<Lanes8, kRays>(b, 0, wr, tmin, tmax, n, t);
 #else
-  return intersect_wide4(*blk, wr, tmin, tmax, m, t);
+  constexpr bool kZero = kRays == BoxRays::kZeroAxes;
+  unsigned m = intersect_wide4<kZero>(b, 0, wr, tmin, tmax, std::min(n, kWideLanes), t);
+  if (n > kWideLanes)
+    m |= intersect_wide4<kZero>(b, kWideLanes, wr, tmin, tmax, n - kWideLanes, t + kWideLanes)
+         << kWideLanes;
+  return m;
 #endif
 }
 

@@ -47,10 +47,10 @@ class InstancedHierarchy {
   std::vector<InstanceData> instances;
   int levels = 0;
   /// The top tree as the SIMD traversal reads it (hierarchy/wide.h), built by `build_wide`
-  /// after the bake. An interior top node's blocks hold its children's boxes; a top leaf's
-  /// header has `leaf == kWideLeaf` and its blocks hold the world boxes of its instances
-  /// (`top_items[first .. +count)`). Inside an instance the traversal reads the mesh's own
-  /// `WideNodes` and transforms the boxes per visit.
+  /// after the bake. Every top node has records: an interior node's hold its children's boxes
+  /// and references; a top leaf's (reference marked kWideRefLeaf) hold the world boxes of its
+  /// instances (`top_items[first .. +count)`) and their instance indices. Inside an instance
+  /// the traversal reads the mesh's own `WideNodes` and transforms the boxes per visit.
   WideNodes top_wide;
 
   static constexpr std::uint64_t id(std::uint64_t instance_plus_one, std::uint32_t local) {

@@ -1,6 +1,7 @@
 #include "amalgam/hierarchy/wide.h"
 
 #include <algorithm>
+#include <cstring>
 
 #include "amalgam/hierarchy/explicit.h"
 #include "amalgam/hierarchy/instanced.h"
@@ -9,19 +10,58 @@
 namespace amalgam {
 namespace {
 
-/// Fills `b` with the boxes of children c0 .. c0 + 3 of a node of `count` children, `box(c)`
-/// (unused lanes empty).
-template <class F>
-void fill_block(WideBox4& b, int c0, int count, F&& box) {
-  for (int lane = 0; lane < kWideLanes; ++lane) {
-    const int c = c0 + lane;
-    const Bbox bb = c < count ? box(c) : Bbox{};
-    for (int a = 0; a < 3; ++a) b.lo[a][lane] = bb.lo[a], b.hi[a][lane] = bb.hi[a];
+/// The records of a node of `count` children (hierarchy/wide.h).
+std::size_t records_of(int count) {
+  return std::max<std::size_t>(1, (static_cast<std::size_t>(count) + kBoxLanes - 1) / kBoxLanes);
+}
+
+/// Writes the records from record `first` of node `node` of `count` children: child c's box
+/// `box(c)` and reference `ref(c)` in lane c % 8 of record first + c / 8.
+template <class Box, class Ref>
+void fill_records(WideNodes& w, std::uint32_t first, std::uint32_t node, int count, Box&& box,
+                  Ref&& ref) {
+  unsigned char* base =
+      reinterpret_cast<unsigned char*>(w.pool.data()) + std::size_t{first} * kWideRecordBytes;
+  for (std::size_t k = 0; k < records_of(count); ++k, base += kWideRecordBytes) {
+    w.record_node[first + k] = node;
+    for (int lane = 0; lane < kBoxLanes; ++lane) {
+      const int c = static_cast<int>(k) * kBoxLanes + lane;
+      const Bbox bb = c < count ? box(c) : Bbox{};
+      const WideRef r = c < count ? ref(c) : 0;
+      for (int a = 0; a < 3; ++a) {
+        const float lo = bb.lo[a], hi = bb.hi[a];
+        std::memcpy(base + (a * kBoxLanes + lane) * sizeof(float), &lo, sizeof lo);
+        std::memcpy(base + ((3 + a) * kBoxLanes + lane) * sizeof(float), &hi, sizeof hi);
+      }
+      std::memcpy(base + (6 * kBoxLanes + lane) * sizeof(float), &r, sizeof r);
+    }
   }
 }
 
-std::uint8_t lane_mask(int count) {
-  return static_cast<std::uint8_t>((1u << std::min<int>(count, 8)) - 1u);
+/// Where each interior node's records start (`is_interior(i)`), in node order: the headers'
+/// `block`; returns the number of records, or 0 when a reference cannot address them all.
+template <class Interior>
+std::size_t assign_records(std::vector<WideHeader>& headers, Interior&& is_interior) {
+  if (headers.size() >= kWideMaxNodes) return 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < headers.size(); ++i)
+    if (is_interior(i)) {
+      headers[i].block = static_cast<std::uint32_t>(n);
+      n += records_of(headers[i].count);
+      if (n * kWideRecordBytes >= kWideMaxPoolBytes) return 0;
+    }
+  return n;
+}
+
+/// The pool and its owners for `records` records.
+void allocate(WideNodes& w, std::size_t records) {
+  w.pool.assign(records * kWideRecordBytes / sizeof(WideUnit), WideUnit{});
+  w.record_node.assign(records, 0);
+}
+
+/// The reference of an interior node of `count` children whose records start at `first`.
+WideRef interior_ref(std::uint32_t first, int count) {
+  return wide_interior_ref(std::uint64_t{first} * kWideRecordBytes, count);
 }
 
 }  // namespace
@@ -30,75 +70,91 @@ void build_wide(ExplicitHierarchy& h) {
   WideNodes& w = h.wide;
   const std::vector<Primitive>& prims = h.prims.edit();  // the whole form, to classify and pack
   const std::size_t n = h.nodes.size();
+  w = WideNodes{};
   w.headers.assign(n, WideHeader{});
-  // Each node's header but for where its blocks or packs start (in parallel: a leaf reads its
-  // primitives), then those starts in node order (a prefix sum), then the blocks (in parallel
-  // again) and the packs: the layout of a serial pass over the nodes, bit for bit.
+  // Each node's header but for where its records or packs start (in parallel: a leaf reads its
+  // primitives), then where the records start in node order (a prefix sum), then the records
+  // (in parallel again) and the packs: the layout of a serial pass over the nodes, bit for bit.
   for_each_index(n, [&](std::size_t i) {
     const ExplicitNode& nd = h.nodes[i];
     WideHeader& hd = w.headers[i];
     hd.first = nd.first;
     hd.count = nd.count;
     hd.leaf = nd.leaf ? kWideLeaf : kWideInterior;
-    hd.lanes = nd.leaf ? 0 : lane_mask(nd.count);
     if (!nd.leaf) return;
     bool triangles = nd.count > 0;
     for (int j = 0; j < nd.count; ++j)
       triangles = triangles && prims[nd.first + j].kind == PrimKind::kTriangle;
     if (triangles) hd.leaf = kWideTriangleLeaf;  // else spheres or boxes: the scalar loop
   });
-  std::size_t n_blocks = 0;
+  const std::size_t n_records =
+      assign_records(w.headers, [&](std::size_t i) { return !h.nodes[i].leaf; });
   std::vector<PrimRange> leaves;
-  for (WideHeader& hd : w.headers) {
-    if (hd.leaf == kWideInterior) {
-      hd.block = static_cast<std::uint32_t>(n_blocks);
-      n_blocks += (hd.count + kWideLanes - 1) / kWideLanes;
-    } else if (hd.leaf == kWideTriangleLeaf) {
-      leaves.push_back({hd.first, hd.count});
-    } else {
-      hd.block = static_cast<std::uint32_t>(n_blocks);  // as the blocks' size at this node
-    }
-  }
-  // One spare block: the AVX2 walk tests a node of up to 4 children with the 8-lane kernel
-  // too, reading the block after its own (lanes masked off by WideHeader::lanes).
-  w.blocks.assign(n_blocks + 1, WideBox4{});
-  for_each_index(n, [&](std::size_t i) {
-    const ExplicitNode& nd = h.nodes[i];
-    const WideHeader& hd = w.headers[i];
-    if (hd.leaf == kWideInterior)
-      for (int c0 = 0, b = 0; c0 < nd.count; c0 += kWideLanes, ++b)
-        fill_block(w.blocks[hd.block + static_cast<std::size_t>(b)], c0, nd.count,
-                   [&](int c) { return h.nodes[nd.first + c].bounds; });
-  });
+  for (const WideHeader& hd : w.headers)
+    if (hd.leaf == kWideTriangleLeaf) leaves.push_back({hd.first, hd.count});
   // The triangle leaves' packs, in node order; the primitives keep only what the packs lack.
   std::vector<std::uint32_t> first_pack(leaves.size());
   h.prims.pack(leaves, first_pack);
   std::size_t k = 0;
   for (WideHeader& hd : w.headers)
     if (hd.leaf == kWideTriangleLeaf) hd.block = first_pack[k++];
+  // No records though the root is interior: more than references address (the generic walk).
+  if (n_records == 0 && n > 0 && !h.nodes[0].leaf) {
+    w = WideNodes{};
+    return;
+  }
+  const auto ref = [&](std::uint32_t j) {
+    const ExplicitNode& c = h.nodes[j];
+    return c.leaf ? kWideRefLeaf | j : interior_ref(w.headers[j].block, c.count);
+  };
+  allocate(w, n_records);
+  for_each_index(n, [&](std::size_t i) {
+    const ExplicitNode& nd = h.nodes[i];
+    if (nd.leaf) return;
+    fill_records(
+        w, w.headers[i].block, static_cast<std::uint32_t>(i), nd.count,
+        [&](int c) { return h.nodes[nd.first + c].bounds; },
+        [&](int c) { return ref(nd.first + static_cast<std::uint32_t>(c)); });
+  });
+  w.root = n ? ref(0) : 0;
 }
 
 void build_wide(InstancedHierarchy& h) {
   for (ExplicitHierarchy& m : h.meshes)
     if (!m.wide_nodes()) build_wide(m);
   WideNodes& w = h.top_wide;
-  w.headers.assign(h.top_nodes.size(), WideHeader{});
-  w.blocks.clear();
-  for (std::size_t i = 0; i < h.top_nodes.size(); ++i) {
-    const ExplicitNode& n = h.top_nodes[i];
-    WideHeader& hd = w.headers[i];
-    hd.first = n.first;
-    hd.count = n.count;
-    hd.leaf = n.leaf ? kWideLeaf : kWideInterior;  // a leaf's children: instances
-    hd.lanes = lane_mask(n.count);
-    hd.block = static_cast<std::uint32_t>(w.blocks.size());
-    for (int c0 = 0; c0 < n.count; c0 += kWideLanes)
-      fill_block(w.blocks.emplace_back(), c0, n.count, [&](int c) {
-        return n.leaf ? h.instances[h.top_items[n.first + c]].world_bounds
-                      : h.top_nodes[n.first + c].bounds;
-      });
+  w = WideNodes{};
+  const std::size_t n = h.top_nodes.size();
+  w.headers.assign(n, WideHeader{});
+  for (std::size_t i = 0; i < n; ++i) {
+    const ExplicitNode& nd = h.top_nodes[i];
+    w.headers[i] = {nd.first, 0, nd.count, nd.leaf ? kWideLeaf : kWideInterior, 0};
   }
-  w.blocks.emplace_back();  // the spare block, as above
+  // Every top node has records: a leaf's lanes are its instances.
+  const std::size_t n_records = assign_records(w.headers, [](std::size_t) { return true; });
+  if (n_records == 0) {
+    w = WideNodes{};
+    return;
+  }
+  const auto ref = [&](std::uint32_t j) {
+    const ExplicitNode& c = h.top_nodes[j];
+    return (c.leaf ? kWideRefLeaf : 0u) | interior_ref(w.headers[j].block, c.count);
+  };
+  allocate(w, n_records);
+  for (std::size_t i = 0; i < n; ++i) {
+    const ExplicitNode& nd = h.top_nodes[i];
+    fill_records(
+        w, w.headers[i].block, static_cast<std::uint32_t>(i), nd.count,
+        [&](int c) {
+          return nd.leaf ? h.instances[h.top_items[nd.first + c]].world_bounds
+                         : h.top_nodes[nd.first + c].bounds;
+        },
+        [&](int c) {
+          return nd.leaf ? h.top_items[nd.first + c]
+                         : ref(nd.first + static_cast<std::uint32_t>(c));
+        });
+  }
+  w.root = n ? ref(0) : 0;
 }
 
 }  // namespace amalgam

@@ -1,8 +1,10 @@
 #pragma once
-/// \file The node data of an explicit hierarchy as the SIMD traversal reads it: per node a
-/// 12-byte header and the SoA boxes of an interior node's children (geometry/wide.h); the
-/// triangles of triangle-only leaves are SoA packs in the primitive store
-/// (`ExplicitHierarchy::prims`, hierarchy/primitives.h).
+/// \file The node data of a hierarchy as the SIMD traversal reads it: a record per interior
+/// node, holding its children's boxes (SoA, geometry/wide.h) and beside them each child's
+/// reference, so that entering a child needs nothing but the reference taken from its parent
+/// (no header to read first). Leaves keep a 12-byte header per node; the triangles of
+/// triangle-only leaves are SoA packs in the primitive store (`ExplicitHierarchy::prims`,
+/// hierarchy/primitives.h).
 ///
 /// `WideNodes` is derived data: `build_wide` fills it from `ExplicitHierarchy::nodes` and packs
 /// `prims` (called at the end of `bake`, so `build_explicit` always has it). The traversal
@@ -11,6 +13,7 @@
 /// afterwards must call `build_wide` again.
 
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "amalgam/geometry/wide.h"
@@ -28,26 +31,98 @@ enum : std::uint8_t {
   kWideTriangleLeaf = 2,  ///< triangles only: ceil(count / 4) packs from `block`
 };
 
-/// A node as the fast traversal reads it (12 bytes instead of ExplicitNode's 32).
+/// What the traversal reads of a leaf (12 bytes; one per node, indexed by node id).
 struct WideHeader {
   std::uint32_t first = 0;  ///< first child (node or primitive), as ExplicitNode::first
-  /// Interior nodes: first of ceil(count / 4) blocks in `blocks`; triangle leaves: first of
-  /// ceil(count / 4) packs in `ExplicitHierarchy::prims.packs()`.
+  /// Interior nodes: their record's index in `WideNodes::record_node`; triangle leaves: their
+  /// first of ceil(count / 4) packs in `ExplicitHierarchy::prims.packs()`.
   std::uint32_t block = 0;
   std::uint16_t count = 0;
   std::uint8_t leaf = kWideInterior;
-  /// Interior nodes: the bit mask of the first min(count, 8) lanes, (1 << that) - 1, so that
-  /// the traversal masks off a block's unused lanes with one load.
-  std::uint8_t lanes = 0;
+  std::uint8_t reserved = 0;  ///< zero: no padding byte left undefined (headers are compared)
+};
+
+/// An interior node's record (224 bytes): its children's boxes in 8-lane rows
+/// (geometry/wide.h, `BoxRows`) and, after them, their references. A node of more than 8
+/// children has ceil(count / 8) consecutive records; lanes beyond the count hold empty boxes
+/// and reference 0; a node without children has one record of empty lanes. (Records of 4 lanes
+/// for nodes of up to 4 children, at half the bytes, made every walk 5-10 % slower: the
+/// variable row stride costs more per node than the smaller footprint saves.)
+///
+/// A reference to a node, as a parent's record holds it for each child and the traversal's
+/// stack carries it (so that entering a child needs nothing but its reference):
+/// - a leaf: kWideRefLeaf | its node id (its header says what it holds);
+/// - an interior node: half the byte offset of its record in `WideNodes::pool` (records are
+///   32-byte aligned, so the low 4 bits are free) | a lane code there: its child count when at
+///   most 8 (the lanes in use: (1 << code) - 1), else kWideRefMany (the count is in its
+///   header).
+/// In the top tree of an instanced hierarchy every node has a record; kWideRefLeaf marks a
+/// top leaf's reference, whose record's lanes are instances (their instance indices).
+using WideRef = std::uint32_t;
+inline constexpr WideRef kWideRefLeaf = 1u << 31;
+inline constexpr WideRef kWideRefMany = 15;
+inline constexpr WideRef kWideRefOffset = ~kWideRefLeaf & ~15u;
+/// The bytes of a record.
+inline constexpr std::uint32_t kWideRecordBytes = 7 * kBoxLanes * sizeof(float);
+/// The largest node id (leaf) and pool size a reference can hold; larger hierarchies take the
+/// generic traversal.
+inline constexpr std::uint64_t kWideMaxNodes = kWideRefLeaf;
+inline constexpr std::uint64_t kWideMaxPoolBytes = std::uint64_t{kWideRefLeaf} * 2;
+
+inline constexpr WideRef wide_interior_ref(std::uint64_t offset, int count) {
+  return static_cast<WideRef>(offset / 2) |
+         static_cast<WideRef>(count > kBoxLanes ? kWideRefMany : count);
+}
+
+/// 32 bytes of the record pool (floats and references, read with SIMD loads and memcpy).
+struct alignas(32) WideUnit {
+  unsigned char bytes[32];
+};
+
+/// One record of the pool as the traversal reads it.
+struct WideRecord {
+  const unsigned char* base;
+  /// The record of interior reference `r` in the pool at `pool`.
+  [[gnu::always_inline]] static WideRecord at(const unsigned char* pool, WideRef r) {
+    return {pool + std::size_t{r & kWideRefOffset} * 2};
+  }
+  BoxRows boxes() const { return {reinterpret_cast<const float*>(base), kBoxLanes}; }
+  WideRef child(int lane) const {
+    WideRef r;
+    std::memcpy(&r, base + (6 * kBoxLanes + lane) * sizeof(float), sizeof r);
+    return r;
+  }
+  /// The next record of a node of more than 8 children.
+  WideRecord next() const { return {base + kWideRecordBytes}; }
 };
 
 struct WideNodes {
-  std::vector<WideHeader> headers;  ///< one per node
-  /// Children's boxes of every interior node, and one spare block at the end (an 8-lane read
-  /// of the last node's single block stays inside the vector).
-  std::vector<WideBox4> blocks;
+  std::vector<WideHeader> headers;         ///< one per node
+  std::vector<WideUnit> pool;              ///< interior nodes' records, in node order
+  std::vector<std::uint32_t> record_node;  ///< per record: its node (LOD policies read it)
+  WideRef root = 0;                        ///< the reference of node 0
+  const unsigned char* pool_bytes() const {
+    return reinterpret_cast<const unsigned char*>(pool.data());
+  }
+  /// The record of interior reference `r` (its first, for more than 8 children).
+  WideRecord record(WideRef r) const { return WideRecord::at(pool_bytes(), r); }
+  /// The node whose record is at interior reference `r`.
+  std::uint32_t record_owner(WideRef r) const {
+    return record_node[std::size_t{r & kWideRefOffset} * 2 / kWideRecordBytes];
+  }
+  /// The id of the node `r` refers to (in a hierarchy's own tree: there kWideRefLeaf marks a
+  /// leaf).
+  std::uint32_t node_of(WideRef r) const {
+    return r & kWideRefLeaf ? r & ~kWideRefLeaf : record_owner(r);
+  }
+  /// The children of interior node `r`.
+  int child_count(WideRef r) const {
+    const int code = static_cast<int>(r & 15u);
+    return code <= kBoxLanes ? code : headers[record_owner(r)].count;
+  }
   std::size_t bytes() const {
-    return headers.size() * sizeof(WideHeader) + blocks.size() * sizeof(WideBox4);
+    return headers.size() * sizeof(WideHeader) + pool.size() * sizeof(WideUnit) +
+           record_node.size() * sizeof(std::uint32_t);
   }
 };
 

@@ -69,29 +69,23 @@ class InstancedWalk {
  private:
   struct StackItem {
     float t;
-    std::uint32_t node;  ///< in the top tree (inst 0) or in the instance's mesh
+    WideRef ref;         ///< in the top tree (inst 0) or in the instance's mesh (hierarchy/wide.h)
     std::uint32_t inst;  ///< 0: the top tree; else instance index + 1 (IH::slot)
     int level;
   };
 
   enum class Next { kEnter, kPop, kStop };  ///< as in WideWalk
 
-#if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
-  static constexpr int kChunk = 2 * kWideLanes;  ///< children per kernel call
-#else
-  static constexpr int kChunk = kWideLanes;
-#endif
-
   template <BoxRays kRays>
   void loop(State& s, const WideNodes& top, float t_root) {
     const WideRay wr = WideRay::of(s.ray);
     StackItem* st = stack_.data();
     std::size_t cap = stack_.size(), sp = 0;
-    StackItem it{t_root, 0, 0, 0};
+    StackItem it{t_root, top.root, 0, 0};
     for (;;) {
       s.counters.count_reached(s.kind);
       Next next;
-      if (s.render_if_policy(IH::id(it.inst, it.node), it.level, it.t))
+      if (s.render_if_policy([&] { return node_id(s, top, it); }, it.level, it.t))
         next = s.done ? Next::kStop : Next::kPop;
       else if (it.inst == 0)
         next = top_node<kRays>(s, top, wr, it, st, cap, sp);
@@ -102,24 +96,30 @@ class InstancedWalk {
     }
   }
 
+  /// The hierarchy's id of the node of stack item `it`.
+  static NodeId node_id(const State& s, const WideNodes& top, const StackItem& it) {
+    if (it.inst == 0) return IH::id(0, top.record_owner(it.ref));
+    return IH::id(it.inst, s.h.meshes[s.h.instances[it.inst - 1].mesh].wide.node_of(it.ref));
+  }
+
   /// A top-level node: its children are top nodes or, for a leaf, instance roots.
   template <BoxRays kRays>
   Next top_node(State& s, const WideNodes& top, const WideRay& wr, StackItem& it, StackItem*& st,
                 std::size_t& cap, std::size_t& sp) {
-    const WideHeader hd = top.headers[it.node];
+    const WideRecord rec = top.record(it.ref);
+    const int count = top.child_count(it.ref);
     const int cl = it.level + 1;
-    s.counters.count_tests(s.kind, s.object_kind(cl), cl, static_cast<std::uint64_t>(hd.count));
-    const WideBox4* blk = top.blocks.data() + hd.block;
-    const std::uint32_t* items = s.h.top_items.data() + hd.first;
-    const bool instances = hd.leaf == kWideLeaf;
+    s.counters.count_tests(s.kind, s.object_kind(cl), cl, static_cast<std::uint64_t>(count));
+    const bool instances = it.ref & kWideRefLeaf;
     return children(
-        it, st, cap, sp, hd.count,
+        it, st, cap, sp, count,
         [&](int c0, int m, float* t) {
-          return box_test_blocks<kRays>(blk + c0 / kWideLanes, wr, s.ray.tmin, s.ray.tmax, m, t);
+          return box_test_block<kRays>(nth(rec, c0).boxes(), wr, s.ray.tmin, s.ray.tmax, m, t);
         },
         [&](int c) {
-          return instances ? StackItem{0, 0, items[c] + 1u, cl}
-                           : StackItem{0, hd.first + static_cast<std::uint32_t>(c), 0, cl};
+          const WideRef r = nth(rec, c).child(c % kBoxLanes);
+          if (!instances) return StackItem{0, r, 0, cl};
+          return StackItem{0, s.h.meshes[s.h.instances[r].mesh].wide.root, r + 1u, cl};
         });
   }
 
@@ -131,17 +131,16 @@ class InstancedWalk {
     const IH::InstanceData& in = s.h.instances[inst - 1];
     const ExplicitHierarchy& mesh = s.h.meshes[in.mesh];
     const WideNodes& w = mesh.wide;
-    const WideHeader hd = w.headers[it.node];
     const int cl = it.level + 1;
-    const int count = hd.count;
-    if (hd.leaf == kWideTriangleLeaf) {
-      const WideRay& owr = in.identity ? wr : object_ray(s, in, inst);
-      PackLeaf<State>::test(s, mesh.prims.packs().data() + hd.block, owr, IH::id(inst, hd.first),
-                            count, cl);
-      return s.done ? Next::kStop : Next::kPop;
-    }
-    if (hd.leaf == kWideLeaf) {  // spheres or boxes: the generic path's test
-      for (int i = 0; i < count; ++i) {
+    if (it.ref & kWideRefLeaf) {
+      const WideHeader hd = w.headers[it.ref & ~kWideRefLeaf];
+      if (hd.leaf == kWideTriangleLeaf) {
+        const WideRay& owr = in.identity ? wr : object_ray(s, in, inst);
+        PackLeaf<State>::test(s, mesh.prims.packs().data() + hd.block, owr, IH::id(inst, hd.first),
+                              hd.count, cl);
+        return s.done ? Next::kStop : Next::kPop;
+      }
+      for (int i = 0; i < hd.count; ++i) {  // spheres or boxes: the generic path's test
         s.counters.count_test(s.kind, ObjectKind::kPrimitive, cl);
         const PrimId id = IH::id(inst, hd.first + static_cast<std::uint32_t>(i));
         if (auto hit = s.h.intersect(id, s.ray)) s.on_primitive(id, cl, *hit);
@@ -149,39 +148,44 @@ class InstancedWalk {
       }
       return Next::kPop;
     }
+    const WideRecord rec = w.record(it.ref);
+    const int count = w.child_count(it.ref);
     s.counters.count_tests(s.kind, s.object_kind(cl), cl, static_cast<std::uint64_t>(count));
-    const WideBox4* blk = w.blocks.data() + hd.block;
-    auto child = [&](int c) {
-      return StackItem{0, hd.first + static_cast<std::uint32_t>(c), inst, cl};
-    };
+    auto child = [&](int c) { return StackItem{0, nth(rec, c).child(c % kBoxLanes), inst, cl}; };
     if (in.identity) {
       return children(
           it, st, cap, sp, count,
           [&](int c0, int m, float* t) {
-            return box_test_blocks<kRays>(blk + c0 / kWideLanes, wr, s.ray.tmin, s.ray.tmax, m, t);
+            return box_test_block<kRays>(nth(rec, c0).boxes(), wr, s.ray.tmin, s.ray.tmax, m, t);
           },
           child);
     }
     return children(
         it, st, cap, sp, count,
         [&](int c0, int m, float* t) {
-          return world_boxes<kRays>(in, blk + c0 / kWideLanes, wr, s.ray.tmin, s.ray.tmax, m, t);
+          return world_boxes<kRays>(in, nth(rec, c0).boxes(), wr, s.ray.tmin, s.ray.tmax, m, t);
         },
         child);
   }
 
-  /// The hit children of a node of `count` children, tested `kChunk` at a time
-  /// by `test(c0, m, t)` (the mask of the hit lanes among children c0 .. c0 + m, their
-  /// entries in t), pushed farthest first as WideWalk does (ties: stored order); `make(c)` is
-  /// child c's stack item (its t filled in here). kEnter with `it` the nearest hit child.
+  /// The record holding child `c` of a node whose first record is `rec`.
+  [[gnu::always_inline]] static WideRecord nth(WideRecord rec, int c) {
+    for (; c >= kBoxLanes; c -= kBoxLanes) rec = rec.next();
+    return rec;
+  }
+
+  /// The hit children of a node of `count` children, tested a block (8) at a time by
+  /// `test(c0, m, t)` (the mask of the hit lanes among children c0 .. c0 + m, their entries in
+  /// t), pushed farthest first as WideWalk does (ties: stored order); `make(c)` is child c's
+  /// stack item (its t filled in here). kEnter with `it` the nearest hit child.
   template <class Test, class Make>
   [[gnu::always_inline]] Next children(StackItem& it, StackItem*& st, std::size_t& cap,
                                        std::size_t& sp, int count, Test&& test, Make&& make) {
     reserve_stack(stack_, st, cap, sp + static_cast<std::size_t>(count));
     const std::size_t base = sp;
-    for (int c0 = 0; c0 < count; c0 += kChunk) {
-      alignas(32) float t[kChunk];
-      push_sorted(st, sp, base, test(c0, std::min(count - c0, kChunk), t), t,
+    for (int c0 = 0; c0 < count; c0 += kBoxLanes) {
+      alignas(32) float t[kBoxLanes];
+      push_sorted(st, sp, base, test(c0, std::min(count - c0, kBoxLanes), t), t,
                   [&](int lane) { return make(c0 + lane); });
     }
     if (sp == base) return Next::kPop;
@@ -189,43 +193,52 @@ class InstancedWalk {
     return Next::kEnter;
   }
 
-  /// `box_test_blocks` on the world boxes of the transformed object boxes of instance `in` in the
-  /// blocks at `blk` (`InstancedHierarchy::world_box` of each).
+  /// `box_test_block` on the world boxes of the transformed object boxes of instance `in` in
+  /// the rows `b` (`InstancedHierarchy::world_box` of each), the first `m` lanes.
   template <BoxRays kRays>
-  [[gnu::always_inline]] static unsigned world_boxes(const IH::InstanceData& in,
-                                                     const WideBox4* blk, const WideRay& wr,
-                                                     float tmin, float tmax, int m, float* t) {
+  [[gnu::always_inline]] static unsigned world_boxes(const IH::InstanceData& in, BoxRows b,
+                                                     const WideRay& wr, float tmin, float tmax,
+                                                     int m, float* t) {
 #if AMALGAM_WIDE_SSE
 #if defined(AMALGAM_ISA_AVX2)
-    if (m > kWideLanes) return world_box_test<Lanes8, kRays>(in, blk, wr, tmin, tmax, m, t);
-#endif
-    return world_box_test<Lanes4, kRays>(in, blk, wr, tmin, tmax, m, t);
+    return world_box_test<Lanes8, kRays>(in, b, 0, wr, tmin, tmax, m, t);
 #else
-    WideBox4 w;
+    unsigned mask =
+        world_box_test<Lanes4, kRays>(in, b, 0, wr, tmin, tmax, std::min(m, kWideLanes), t);
+    if (m > kWideLanes)
+      mask |= world_box_test<Lanes4, kRays>(in, b, kWideLanes, wr, tmin, tmax, m - kWideLanes,
+                                            t + kWideLanes)
+              << kWideLanes;
+    return mask;
+#endif
+#else
+    WideBox8 w;
     for (int l = 0; l < m; ++l) {
-      const Bbox b = IH::world_box(in, Bbox{{blk->lo[0][l], blk->lo[1][l], blk->lo[2][l]},
-                                            {blk->hi[0][l], blk->hi[1][l], blk->hi[2][l]}});
-      for (int a = 0; a < 3; ++a) w.lo[a][l] = b.lo[a], w.hi[a][l] = b.hi[a];
+      Bbox ob;
+      for (int a = 0; a < 3; ++a)
+        ob.lo[a] = b.rows[a * b.stride + l], ob.hi[a] = b.rows[(3 + a) * b.stride + l];
+      const Bbox wb = IH::world_box(in, ob);
+      for (int a = 0; a < 3; ++a) w.lo[a][l] = wb.lo[a], w.hi[a][l] = wb.hi[a];
     }
-    return intersect_wide4(w, wr, tmin, tmax, m, t);
+    return box_test_block<kRays>(w.rows(), wr, tmin, tmax, m, t);
 #endif
   }
 
 #if AMALGAM_WIDE_SSE
-  /// world_box on L::kLanes boxes at once, in registers, then the box kernel on them. The
-  /// float operations are world_box's, in its order, lane by lane (no fused multiply-add: the
-  /// build enables none). An empty box (unused lanes included) keeps its bounds, as there.
+  /// world_box on lanes c0 .. c0 + L::kLanes - 1 of the rows `b` at once, in registers, then
+  /// the box kernel on them. The float operations are world_box's, in its order, lane by lane
+  /// (no fused multiply-add: the build enables none). An empty box (unused lanes included)
+  /// keeps its bounds, as there.
   template <class L, BoxRays kRays>
-  [[gnu::always_inline]] static unsigned world_box_test(const IH::InstanceData& in,
-                                                        const WideBox4* blk, const WideRay& wr,
-                                                        float tmin, float tmax, int m, float* t) {
+  [[gnu::always_inline]] static unsigned world_box_test(const IH::InstanceData& in, BoxRows b,
+                                                        int c0, const WideRay& wr, float tmin,
+                                                        float tmax, int m, float* t) {
     using V = typename L::V;
-    constexpr std::uint32_t kHi = 3 * kWideLanes * sizeof(float);
     V lo[3], hi[3], c[3], h[3];
     const V half = L::set1(0.5f);
     for (int a = 0; a < 3; ++a) {
-      const std::uint32_t axis = static_cast<std::uint32_t>(a * kWideLanes * sizeof(float));
-      lo[a] = L::load(blk, axis), hi[a] = L::load(blk, kHi + axis);
+      lo[a] = L::load(b.rows + a * b.stride + c0),
+      hi[a] = L::load(b.rows + (3 + a) * b.stride + c0);
       c[a] = L::mul(L::add(lo[a], hi[a]), half);  // Bbox::center
       h[a] = L::mul(L::sub(hi[a], lo[a]), half);  // Bbox::extent() * 0.5f
     }

@@ -96,11 +96,16 @@ struct RayState {
            lod.render(b, level, ray, t, t <= ray.tmin && b.contains(ray.origin));
   }
 
-  /// The fast walks' step on reaching node `id` (level `level`, entered at `t`): when the LOD
-  /// policy renders it, renders it (true); else false: the walk descends.
-  [[gnu::always_inline]] bool render_if_policy(NodeId id, int level, float t) {
+  /// The fast walks' step on reaching node `id_of()` (level `level`, entered at `t`): when the
+  /// LOD policy renders it, renders it (true); else false: the walk descends. The node's id is
+  /// looked up only where the policy may render.
+  template <class IdOf>
+  [[gnu::always_inline]] bool render_if_policy([[maybe_unused]] IdOf&& id_of,
+                                               [[maybe_unused]] int level,
+                                               [[maybe_unused]] float t) {
     if constexpr (kMayRender) {
       if (lod.may_render(level)) {
+        const NodeId id = id_of();
         const Bbox b = h.bounds(id);
         if (renders(b, level, t)) {
           render_amalgam(id, level, b, t);

@@ -74,7 +74,7 @@ class Traversal {
     if (!intersect_box(s_.ray, b, t0, t1)) return;
     if constexpr (kWide) {
       if (const WideNodes* w = s_.h.wide_nodes()) {
-        wide_.run(s_, *w, static_cast<std::uint32_t>(root), t0);
+        wide_.run(s_, *w, t0);
         return;
       }
     }

@@ -32,15 +32,6 @@ concept WideHierarchy = requires(const H& h, std::size_t i, Vec3& a) {
 
 AMALGAM_ISA_BEGIN
 
-/// Fetches the headers of children `first` .. `first + count - 1` (contiguous, at most two
-/// cache lines) while their boxes are tested: the child entered next reads its header first,
-/// and on large scenes that read missed in the caches right before its boxes' read did.
-[[gnu::always_inline]] inline void prefetch_headers(const WideHeader* headers, std::uint32_t first,
-                                                    int count) {
-  __builtin_prefetch(headers + first);
-  __builtin_prefetch(headers + first + count - 1);
-}
-
 /// The triangles of a triangle-only leaf, tested from their SoA packs against the ray `wr`
 /// (the ray in the leaf's own space: the instanced walk passes the object-space ray) over
 /// the state's [tmin, tmax]: shared by the explicit and the instanced walk.
@@ -105,9 +96,9 @@ template <class State>
 class WideWalk {
  public:
   /// Traces `s.ray` from the root (its box met at `t_root`).
-  void run(State& s, const WideNodes& w, std::uint32_t root, float t_root) {
+  void run(State& s, const WideNodes& w, float t_root) {
     if (stack_.size() < 64) stack_.resize(64);
-    stack_[0] = {t_root, root, 0};
+    stack_[0] = {t_root, w.root, 0};
     // A ray with a zero direction component needs the box test's containment branch per
     // axis, and one with an infinite origin or inverse direction its NaN-skipping start;
     // all others (nearly every ray) run a loop without them.
@@ -128,7 +119,7 @@ class WideWalk {
  private:
   struct StackItem {
     float t;
-    std::uint32_t node;
+    WideRef ref;  ///< the node (hierarchy/wide.h)
     int level;
   };
 
@@ -145,13 +136,13 @@ class WideWalk {
     // The per-ray constants and the stack's base and capacity as locals: members would be
     // reloaded after every store to the stack (a float store may alias them).
     const WideRay wr = WideRay::of(s.ray);
-    const Arrays arr{w.headers.data(), w.blocks.data(), s.h.prims.packs().data()};
+    const Arrays arr{w.headers.data(), w.pool_bytes(), s.h.prims.packs().data(), &w};
     StackItem* st = stack_.data();
     std::size_t cap = stack_.size(), sp = 0;
     StackItem it = st[0];
     for (;;) {
       s.counters.count_reached(s.kind);
-      const Next next = !s.render_if_policy(it.node, it.level, it.t)
+      const Next next = !s.render_if_policy([&] { return w.node_of(it.ref); }, it.level, it.t)
                             ? expand<kRays>(s, arr, wr, it, st, cap, sp)
                         : s.done ? Next::kStop
                                  : Next::kPop;
@@ -164,8 +155,9 @@ class WideWalk {
   /// again at every node: a store to the stack may alias them).
   struct Arrays {
     const WideHeader* headers;
-    const WideBox4* blocks;
+    const unsigned char* pool;
     const TrianglePack4* tris;
+    const WideNodes* nodes;
   };
 
   /// What the walk does after a node: enter `it` (the nearest hit child), pop the stack, or
@@ -178,78 +170,81 @@ class WideWalk {
   /// the pushes straight onto the stack below, took the engine primary rays from 2 578 to
   /// 2 133 instructions per ray; docs/benchmarks.md). kEnter: `it` is now the nearest hit
   /// child, to be entered next (the other hit children are on the stack).
+  ///
+  /// An interior node is read from its reference alone: the record's address and the lanes
+  /// in use come from it, the children's references from the record, beside their boxes.
   template <BoxRays kRays>
   [[gnu::always_inline]] Next expand(State& s, const Arrays& w, const WideRay& wr, StackItem& it,
                                      StackItem*& st, std::size_t& cap, std::size_t& sp) {
-    const WideHeader hd = w.headers[it.node];
+    const WideRef ref = it.ref;
     const int cl = it.level + 1;
-    const int count = hd.count;
-    if (hd.leaf == kWideTriangleLeaf) {
-      PackLeaf<State>::test(s, w.tris + hd.block, wr, hd.first, count, cl);
-      return s.done ? Next::kStop : Next::kPop;
-    }
-    if (hd.leaf == kWideLeaf) {
-      for (int i = 0; i < count; ++i) {
+    if (ref & kWideRefLeaf) {
+      const WideHeader hd = w.headers[ref & ~kWideRefLeaf];
+      if (hd.leaf == kWideTriangleLeaf) {
+        PackLeaf<State>::test(s, w.tris + hd.block, wr, hd.first, hd.count, cl);
+        return s.done ? Next::kStop : Next::kPop;
+      }
+      for (int i = 0; i < hd.count; ++i) {
         s.counters.count_test(s.kind, ObjectKind::kPrimitive, cl);
         primitive(s, wr.pre, hd.first + static_cast<std::uint32_t>(i), cl);
         if (s.done) return Next::kStop;
       }
       return Next::kPop;
     }
-    const ObjectKind ok = s.object_kind(cl);
-    s.counters.count_tests(s.kind, ok, cl, static_cast<std::uint64_t>(count));
-    const WideBox4* blk = w.blocks + hd.block;
-    prefetch_headers(w.headers, hd.first, count);
-    // One kernel call for the whole node (arity <= 8 with AVX2, <= 4 otherwise): a single hit
-    // child is entered at once, without touching the stack.
-#if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
-    constexpr int kOneCall = 2 * kWideLanes;
-#else
-    constexpr int kOneCall = kWideLanes;
-#endif
-    if (count <= kOneCall) {
-      alignas(32) float t[kOneCall];
-      // The kernel tests all lanes of kOneCall / 4 blocks (a node of up to 4 children reads
-      // the block after its own too: no branch on the count, and WideNodes keeps a spare block
-      // at the end); the header's mask keeps the children's lanes.
-      const unsigned mask =
-          box_test_blocks<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, kOneCall, t) & hd.lanes;
-      if (mask == 0) return Next::kPop;
-      const int l0 = std::countr_zero(mask);
-      const unsigned rest = mask & (mask - 1);
-      if (rest == 0) {
-        it = {t[l0], hd.first + static_cast<std::uint32_t>(l0), cl};
-        return Next::kEnter;
-      }
-      reserve(st, cap, sp + count);
-      if ((rest & (rest - 1)) == 0) {  // two hits: one comparison (ties: the first in order)
-        const int l1 = std::countr_zero(rest);
-        const bool second = t[l1] < t[l0];
-        const int near = second ? l1 : l0, far = second ? l0 : l1;
-        st[sp++] = {t[far], hd.first + static_cast<std::uint32_t>(far), cl};
-        it = {t[near], hd.first + static_cast<std::uint32_t>(near), cl};
-        return Next::kEnter;
-      }
-      push_sorted(st, sp, mask, t, hd.first, cl, sp);
-      it = st[--sp];
+    const int count = static_cast<int>(ref & 15u);
+    if (count > kBoxLanes) [[unlikely]]
+      return many<kRays>(s, w, wr, it, st, cap, sp, cl);
+    const WideRecord rec = WideRecord::at(w.pool, ref);
+    s.counters.count_tests(s.kind, s.object_kind(cl), cl, static_cast<std::uint64_t>(count));
+    // One kernel call for the whole node: a single hit child is entered at once, without
+    // touching the stack.
+    alignas(32) float t[kBoxLanes];
+    const unsigned mask = box_test_block<kRays>(rec.boxes(), wr, s.ray.tmin, s.ray.tmax, count, t);
+    if (mask == 0) return Next::kPop;
+    const int l0 = std::countr_zero(mask);
+    const unsigned rest = mask & (mask - 1);
+    if (rest == 0) {
+      it = {t[l0], rec.child(l0), cl};
       return Next::kEnter;
     }
-    reserve(st, cap, sp + count);
-    const std::size_t base = sp;
-    int c0 = 0;
-#if AMALGAM_WIDE_SSE && defined(AMALGAM_ISA_AVX2)
-    for (; count - c0 > kWideLanes; c0 += 2 * kWideLanes, blk += 2) {
-      alignas(32) float t[2 * kWideLanes];
-      const int m = std::min(count - c0, 2 * kWideLanes);
-      push_sorted(st, sp, box_test_blocks<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, m, t), t,
-                  hd.first + static_cast<std::uint32_t>(c0), cl, base);
+    reserve(st, cap, sp + kBoxLanes);
+    // The records of the children hit: every one but the nearest is entered later, if at all.
+    for (unsigned m = mask; m; m &= m - 1) {
+      const WideRef c = rec.child(std::countr_zero(m));
+      if (!(c & kWideRefLeaf)) {
+        const unsigned char* p = WideRecord::at(w.pool, c).base;
+        __builtin_prefetch(p), __builtin_prefetch(p + 64), __builtin_prefetch(p + 128),
+            __builtin_prefetch(p + 192);
+      }
     }
-#endif
-    for (; c0 < count; c0 += kWideLanes, ++blk) {
-      alignas(16) float t[kWideLanes];
-      const int m = std::min(count - c0, kWideLanes);
-      push_sorted(st, sp, box_test_blocks<kRays>(blk, wr, s.ray.tmin, s.ray.tmax, m, t), t,
-                  hd.first + static_cast<std::uint32_t>(c0), cl, base);
+    if ((rest & (rest - 1)) == 0) {  // two hits: one comparison (ties: the first in order)
+      const int l1 = std::countr_zero(rest);
+      const bool second = t[l1] < t[l0];
+      const int near = second ? l1 : l0, far = second ? l0 : l1;
+      st[sp++] = {t[far], rec.child(far), cl};
+      it = {t[near], rec.child(near), cl};
+      return Next::kEnter;
+    }
+    push_sorted(st, sp, mask, t, rec, cl, sp);
+    it = st[--sp];
+    return Next::kEnter;
+  }
+
+  /// A node of more than 8 children: its consecutive records, each tested and pushed, the
+  /// nearest hit child then entered.
+  template <BoxRays kRays>
+  Next many(State& s, const Arrays& w, const WideRay& wr, StackItem& it, StackItem*& st,
+            std::size_t& cap, std::size_t& sp, int cl) {
+    const int count = w.nodes->child_count(it.ref);
+    s.counters.count_tests(s.kind, s.object_kind(cl), cl, static_cast<std::uint64_t>(count));
+    reserve(st, cap, sp + static_cast<std::size_t>(count));
+    const std::size_t base = sp;
+    WideRecord rec = w.nodes->record(it.ref);
+    for (int c0 = 0; c0 < count; c0 += kBoxLanes, rec = rec.next()) {
+      alignas(32) float t[kBoxLanes];
+      const int m = std::min(count - c0, kBoxLanes);
+      push_sorted(st, sp, box_test_block<kRays>(rec.boxes(), wr, s.ray.tmin, s.ray.tmax, m, t), t,
+                  rec, cl, base);
     }
     if (sp == base) return Next::kPop;
     it = st[--sp];
@@ -261,13 +256,13 @@ class WideWalk {
     reserve_stack(stack_, st, cap, need);
   }
 
-  /// Pushes the lanes of `mask` (children `first + lane`, entered at `t[lane]`) above `base`
-  /// (state.h, `push_sorted`).
+  /// Pushes the lanes of `mask` (children `rec.child(lane)`, entered at `t[lane]`) above
+  /// `base` (state.h, `push_sorted`).
   [[gnu::always_inline]] static void push_sorted(StackItem* st, std::size_t& sp, unsigned mask,
-                                                 const float* t, std::uint32_t first, int level,
+                                                 const float* t, const WideRecord& rec, int level,
                                                  std::size_t base) {
     amalgam::push_sorted(st, sp, base, mask, t, [&](int lane) {
-      return StackItem{0, first + static_cast<std::uint32_t>(lane), level};
+      return StackItem{0, rec.child(lane), level};
     });
   }
 
