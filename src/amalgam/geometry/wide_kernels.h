@@ -179,13 +179,14 @@ struct Lanes8 {
 /// infinite starting values of the interval are left out (the same floats without them).
 enum class BoxRays { kZeroAxes, kNonZero };
 
-/// Whether `r` may take the kNonZero kernels: a finite origin and a finite inverse of every
-/// direction component (so no zero component either). Then (plane - o) * inv is never NaN
-/// for a box's planes, which are never NaN.
+/// Whether `r` may take the kNonZero kernels: a finite origin and a finite, nonzero inverse of
+/// every direction component (so no zero component either). Then (plane - o) * inv is never
+/// NaN for a box's planes, which are never NaN, infinite ones (empty boxes) included.
 [[gnu::always_inline]] inline bool box_rays_simple(const Ray& r) {
-  for (int a = 0; a < 3; ++a)
-    if (!(std::fabs(r.origin[a]) < kInfinity) || !(std::fabs(r.inv_dir[a]) < kInfinity))
-      return false;
+  for (int a = 0; a < 3; ++a) {
+    const float inv = std::fabs(r.inv_dir[a]);
+    if (!(std::fabs(r.origin[a]) < kInfinity) || !(inv < kInfinity) || !(inv > 0.0f)) return false;
+  }
   return true;
 }
 
@@ -234,11 +235,17 @@ template <class L, BoxRays kRays>
     t_far = L::min(tf, t_far);    // if (t1 < t_far) t_far = t1
   }
   t_far = L::mul(t_far, L::set1(kGrow));
-  ok = L::band(ok, L::le(t_near, t_far));
   const V s0 = L::max(L::set1(tmin), t_near);  // std::max(t_near, tmin)
   const V s1 = L::min(L::set1(tmax), t_far);   // std::min(t_far, tmax)
-  ok = L::band(ok, L::le(s0, s1));
   L::store(t_entry, s0);
+  if constexpr (kRays == BoxRays::kNonZero) {
+    // No NaN in t_near or t_far: s0 <= s1 implies t_near <= s0 <= s1 <= t_far, the scalar
+    // test's first condition (with a NaN tmin or tmax, maxps and minps return t_near and
+    // t_far themselves).
+    return L::mask(L::le(s0, s1)) & ((1u << n) - 1u);
+  }
+  ok = L::band(ok, L::le(t_near, t_far));
+  ok = L::band(ok, L::le(s0, s1));
   return L::mask(ok) & ((1u << n) - 1u);
 }
 
