@@ -195,8 +195,9 @@ L.append("during `rtcCommitScene` (memory monitor), and that plus the shared ver
 L.append("given.\n")
 if any("ours_prims_bytes_per_tri" in b for b in builds.values()):
     L.append("Ours by structure, bytes per triangle: nodes (`ExplicitNode`, 32 B per node), appearances")
-    L.append("(44 B per node), the SIMD traversal's nodes (a 12-byte header per node, the SoA child boxes")
-    L.append("of interior nodes, 96 B per four children) and the primitives (src/amalgam/hierarchy/")
+    L.append("(44 B per node), the SIMD traversal's nodes (a 12-byte header per node and, per interior")
+    L.append("node, a 224-byte record of its children's SoA boxes and references, 8 lanes, plus its")
+    L.append("4-byte owner: src/amalgam/hierarchy/wide.h) and the primitives (src/amalgam/hierarchy/")
     L.append("primitives.h: a triangle of a triangle-only leaf is stored once, in the SoA pack the")
     L.append("traversal tests, 144 B per four triangles, unused lanes padded, plus its 4-byte material")
     L.append("and 4-byte slot; any other primitive as a 48-byte `Primitive`).\n")
