@@ -16,7 +16,7 @@ namespace amalgam {
 /// with this build's default settings (max resident set of `amalgam render` at 8x8 pixels,
 /// docs/reliability.md "Resource limits"): for an explicit hierarchy about 215-250 bytes per
 /// triangle (the triangles as read, the SAH's temporaries, nodes, appearances, SIMD child boxes
-/// and triangle packs, the bake's tensors), about 290 for the meshes of an instanced one; per
+/// and triangle packs, the bake's tensors), about 305 for the meshes of an instanced one; per
 /// instance (its transform data, the top-level tree and its bake) about 420 bytes. Small scenes
 /// (under about 30 MiB) are overestimated, by up to 40 % (the allocator reuses the memory of
 /// the process), which errs on the safe side.
@@ -24,7 +24,7 @@ struct MemoryModel {
   static constexpr std::uint64_t kProcess = 8u << 20;          ///< the process before any scene
   static constexpr std::uint64_t kSceneFile = 8u << 20;        ///< reading a scene file or mesh
   static constexpr std::uint64_t kPerTriangle = 250;           ///< explicit hierarchy, at its peak
-  static constexpr std::uint64_t kPerInstancedTriangle = 290;  ///< a mesh placed by instances
+  static constexpr std::uint64_t kPerInstancedTriangle = 305;  ///< a mesh placed by instances
   static constexpr std::uint64_t kPerInstance = 420;           ///< instanced hierarchy
   /// The film at its peak, per pixel: the progressive state (colour sum 12 bytes, tests 8,
   /// auxiliary sums 40: render.h's FilmState and PixelAov), either the pass's copy of it (60)
