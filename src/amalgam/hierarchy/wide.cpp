@@ -73,8 +73,9 @@ void build_wide(ExplicitHierarchy& h) {
   w = WideNodes{};
   w.headers.assign(n, WideHeader{});
   // Each node's header but for where its records or packs start (in parallel: a leaf reads its
-  // primitives), then where the records start in node order (a prefix sum), then the records
-  // (in parallel again) and the packs: the layout of a serial pass over the nodes, bit for bit.
+  // primitives), then where the records start in node order (a prefix sum), then the packs
+  // (in node order), then the records (in parallel again): the layout of a serial pass over
+  // the nodes, bit for bit.
   for_each_index(n, [&](std::size_t i) {
     const ExplicitNode& nd = h.nodes[i];
     WideHeader& hd = w.headers[i];

@@ -216,9 +216,7 @@ class WideWalk {
       it = {t[near], rec.child(near), cl};
       return Next::kEnter;
     }
-    amalgam::push_sorted(st, sp, sp, mask, t, [&](int lane) {
-      return StackItem{0, prefetched(w, rec.child(lane)), cl};
-    });
+    push_sorted(w, st, sp, sp, mask, t, rec, cl);
     it = st[--sp];
     return Next::kEnter;
   }
@@ -248,8 +246,8 @@ class WideWalk {
     for (int c0 = 0; c0 < count; c0 += kBoxLanes, rec = rec.next()) {
       alignas(32) float t[kBoxLanes];
       const int m = std::min(count - c0, kBoxLanes);
-      push_sorted(st, sp, box_test_block<kRays>(rec.boxes(), wr, s.ray.tmin, s.ray.tmax, m, t), t,
-                  rec, cl, base);
+      push_sorted(w, st, sp, base,
+                  box_test_block<kRays>(rec.boxes(), wr, s.ray.tmin, s.ray.tmax, m, t), t, rec, cl);
     }
     if (sp == base) return Next::kPop;
     it = st[--sp];
@@ -262,12 +260,13 @@ class WideWalk {
   }
 
   /// Pushes the lanes of `mask` (children `rec.child(lane)`, entered at `t[lane]`) above
-  /// `base` (state.h, `push_sorted`).
-  [[gnu::always_inline]] static void push_sorted(StackItem* st, std::size_t& sp, unsigned mask,
-                                                 const float* t, const WideRecord& rec, int level,
-                                                 std::size_t base) {
+  /// `base` (state.h, `push_sorted`), each interior child's record prefetched: the one push of
+  /// both a node's three or more hit children and the records of a node of more than 8.
+  [[gnu::always_inline]] static void push_sorted(const Arrays& w, StackItem* st, std::size_t& sp,
+                                                 std::size_t base, unsigned mask, const float* t,
+                                                 const WideRecord& rec, int level) {
     amalgam::push_sorted(st, sp, base, mask, t, [&](int lane) {
-      return StackItem{0, rec.child(lane), level};
+      return StackItem{0, prefetched(w, rec.child(lane)), level};
     });
   }
 
