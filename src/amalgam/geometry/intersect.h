@@ -224,7 +224,9 @@ inline bool intersect_box(const Ray& ray, const Bbox& box, float& t0, float& t1)
   float t_near, t_far;
   int axis;
   if (!detail::slab<false>(ray, box, t_near, t_far, axis)) return false;
-  t0 = std::max(t_near, ray.tmin);
+  // tmin on a tie: with tmin = +0 an entry of -0 becomes +0, as the SIMD kernels' integer
+  // maximum gives it (wide_kernels.h).
+  t0 = t_near > ray.tmin ? t_near : ray.tmin;
   t1 = std::min(t_far, ray.tmax);
   return t0 <= t1;
 }

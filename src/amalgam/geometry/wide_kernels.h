@@ -105,6 +105,11 @@ struct Lanes4 {
   static V andnot(V a, V b) { return _mm_andnot_ps(a, b); }
   static unsigned mask(V a) { return static_cast<unsigned>(_mm_movemask_ps(a)); }
   static void store(float* d, V a) { _mm_storeu_ps(d, a); }
+  // The box kernel's orderings for rays with tmin >= +0 and no NaN (box_test_vectors): the
+  // float forms here, integer ones in Lanes8; both give the kernel's same bits.
+  static V near_of(V t0, V t1) { return _mm_min_ps(t1, t0); }
+  static V far_of(V t0, V t1) { return _mm_max_ps(t0, t1); }
+  static V entry_max(V a, V b) { return _mm_max_ps(a, b); }
 #if defined(AMALGAM_ISA_AVX2)
   // The lower halves of the 8-wide forms, loaded as 4 floats: a cast of the 8-wide value made
   // GCC load it whole, store its lower half to the stack and load that again (engine shadow
@@ -171,6 +176,20 @@ struct Lanes8 {
   static V andnot(V a, V b) { return _mm256_andnot_ps(a, b); }
   static unsigned mask(V a) { return static_cast<unsigned>(_mm256_movemask_ps(a)); }
   static void store(float* d, V a) { _mm256_storeu_ps(d, a); }
+  // The signed 32-bit integer minimum and maximum of float bits for the entry: one cycle of
+  // latency where the float forms take four, on the chain from a node's boxes to its hit
+  // mask. They order non-negative floats as floats do and put every negative float and -0
+  // below them, which box_test_vectors shows is enough for the entry. (Not for the far
+  // distances: there -0 must stay above the negative floats.)
+  static V near_of(V t0, V t1) { return imin(t0, t1); }
+  static V far_of(V t0, V t1) { return _mm256_max_ps(t0, t1); }
+  static V entry_max(V a, V b) { return imax(a, b); }
+  static V imin(V a, V b) {
+    return _mm256_castsi256_ps(_mm256_min_epi32(_mm256_castps_si256(a), _mm256_castps_si256(b)));
+  }
+  static V imax(V a, V b) {
+    return _mm256_castsi256_ps(_mm256_max_epi32(_mm256_castps_si256(a), _mm256_castps_si256(b)));
+  }
   static V origin(const WideRay& r, int a) { return r.o8[a]; }
   static V inv(const WideRay& r, int a) { return r.inv8[a]; }
   static V shear(const WideRay& r, int a) { return r.shear8[a]; }
@@ -186,14 +205,15 @@ struct Lanes8 {
 enum class BoxRays { kZeroAxes, kNonZero };
 
 /// Whether `r` may take the kNonZero kernels: a finite origin and a finite, nonzero inverse of
-/// every direction component (so no zero component either). Then (plane - o) * inv is never
-/// NaN for a box's planes, which are never NaN, infinite ones (empty boxes) included.
+/// every direction component (so no zero component either), tmin +0 or positive and tmax not
+/// NaN. Then (plane - o) * inv is never NaN for a box's planes, which are never NaN, infinite
+/// ones (empty boxes) included, and the kernel may order its distances as integers.
 [[gnu::always_inline]] inline bool box_rays_simple(const Ray& r) {
   for (int a = 0; a < 3; ++a) {
     const float inv = std::fabs(r.inv_dir[a]);
     if (!(std::fabs(r.origin[a]) < kInfinity) || !(inv < kInfinity) || !(inv > 0.0f)) return false;
   }
-  return true;
+  return r.tmin >= 0.0f && !std::signbit(r.tmin) && !std::isnan(r.tmax);
 }
 
 #if AMALGAM_WIDE_SSE
@@ -216,6 +236,31 @@ template <class L, BoxRays kRays>
                                                         float* t_entry) {
   using V = typename L::V;
   constexpr float kGrow = 1.0f + 2.0f * gamma(3);
+  if constexpr (kRays == BoxRays::kNonZero) {
+    // No NaN anywhere and tmin >= +0 (box_rays_simple): the scalar test's result as a short
+    // dependency chain. Its entry max(t_near, tmin) (tmin on a tie) is the maximum of tmin
+    // and the three near distances, taken in any order and, in Lanes8, as integers: a
+    // maximum above tmin is a positive float, whose equal values have equal bits, and one
+    // equal to tmin = +0 is +0 either way, while the negative distances and -0, which the
+    // integer order puts below +0, never win; so an axis's near distance may be the integer
+    // minimum of its pair too (it differs from the float one only where both are below +0).
+    // The test entry <= min(t_far, tmax), with t_far the minimum over the axes of far * (1 +
+    // 2 gamma(3)) (a rounded product is non-decreasing), is entry <= each of them, compared
+    // one by one: no chain of minima.
+    V tn[3], tf[3];
+    for (int a = 0; a < 3; ++a) {
+      const V o = L::origin(r, a), inv = L::inv(r, a);
+      const V t0 = L::mul(L::sub(lo[a], o), inv);
+      const V t1 = L::mul(L::sub(hi[a], o), inv);
+      tn[a] = L::near_of(t0, t1), tf[a] = L::far_of(t0, t1);
+    }
+    const V s0 = L::entry_max(L::entry_max(tn[0], tn[1]), L::entry_max(tn[2], L::set1(tmin)));
+    L::store(t_entry, s0);
+    const V grow = L::set1(kGrow);
+    const V in = L::band(L::band(L::le(s0, L::mul(tf[0], grow)), L::le(s0, L::mul(tf[1], grow))),
+                         L::band(L::le(s0, L::mul(tf[2], grow)), L::le(s0, L::set1(tmax))));
+    return L::mask(in) & ((1u << n) - 1u);
+  }
   V t_near = L::set1(-kInfinity), t_far = L::set1(kInfinity);
   V ok = L::all();
   for (int a = 0; a < 3; ++a) {
@@ -230,26 +275,13 @@ template <class L, BoxRays kRays>
     // scalar: if (t0 > t1) swap. minps(x, y) = x < y ? x : y; maxps(x, y) = x > y ? x : y.
     const V tn = L::min(t1, t0);
     const V tf = L::max(t0, t1);
-    if (a == 0 && kRays == BoxRays::kNonZero) {
-      // No NaN (box_rays_simple): the scalar test's infinite starting values give way to the
-      // first axis's distances, bit for bit, so the interval starts there (the compiler drops
-      // the unused starting values).
-      t_near = tn, t_far = tf;
-      continue;
-    }
     t_near = L::max(tn, t_near);  // if (t0 > t_near) t_near = t0
     t_far = L::min(tf, t_far);    // if (t1 < t_far) t_far = t1
   }
   t_far = L::mul(t_far, L::set1(kGrow));
-  const V s0 = L::max(L::set1(tmin), t_near);  // std::max(t_near, tmin)
+  const V s0 = L::max(t_near, L::set1(tmin));  // t_near > tmin ? t_near : tmin
   const V s1 = L::min(L::set1(tmax), t_far);   // std::min(t_far, tmax)
   L::store(t_entry, s0);
-  if constexpr (kRays == BoxRays::kNonZero) {
-    // No NaN in t_near or t_far: s0 <= s1 implies t_near <= s0 <= s1 <= t_far, the scalar
-    // test's first condition (with a NaN tmin or tmax, maxps and minps return t_near and
-    // t_far themselves).
-    return L::mask(L::le(s0, s1)) & ((1u << n) - 1u);
-  }
   ok = L::band(ok, L::le(t_near, t_far));
   ok = L::band(ok, L::le(s0, s1));
   return L::mask(ok) & ((1u << n) - 1u);
