@@ -77,6 +77,7 @@ void expect_same(const ExplicitHierarchy& a, const ExplicitHierarchy& b) {
       std::memcmp(a.wide.pool.data(), b.wide.pool.data(), a.wide.pool.size() * sizeof(WideUnit)),
       0);
   EXPECT_EQ(a.wide.record_node, b.wide.record_node);
+  EXPECT_EQ(a.wide.pack_node, b.wide.pack_node);
   EXPECT_EQ(a.wide.root, b.wide.root);
   EXPECT_EQ(std::memcmp(a.prims.packs().data(), b.prims.packs().data(),
                         a.prims.packs().size() * sizeof(TrianglePack4)),

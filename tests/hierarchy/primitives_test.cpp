@@ -104,6 +104,44 @@ TEST(PrimitiveStore, BuildWideAgainRepacksTheSameBytes) {
     ASSERT_TRUE(same_bits(a.prims[i], b.prims[i])) << "primitive " << i;
 }
 
+// Every child reference in the records names its child: a one-pack leaf (the default leaves
+// of triangles) by its pack and count, which `pack_node` maps back to the leaf; a mixed leaf by
+// its node id; an interior node by its record, whose owner is the child.
+TEST(PrimitiveStore, ChildReferencesNameTheirChildren) {
+  std::vector<Surface> mats(5);
+  const ExplicitHierarchy h = build_explicit(mixed(), mats);
+  const WideNodes& w = h.wide;
+  ASSERT_NE(h.wide_nodes(), nullptr);
+  ASSERT_EQ(w.pack_node.size(), h.prims.packs().size());
+  std::size_t pack_refs = 0, node_refs = 0;
+  for (std::size_t i = 0; i < h.nodes.size(); ++i) {
+    const ExplicitNode& nd = h.nodes[i];
+    if (nd.leaf) continue;
+    for (int c = 0; c < nd.count; ++c) {
+      const std::uint32_t j = nd.first + static_cast<std::uint32_t>(c);
+      // The parent's records start at the index its header holds.
+      const unsigned char* base = reinterpret_cast<const unsigned char*>(w.pool.data()) +
+                                  std::size_t{w.headers[i].block} * kWideRecordBytes +
+                                  static_cast<std::size_t>(c / kBoxLanes) * kWideRecordBytes;
+      const WideRef r = WideRecord{base}.child(c % kBoxLanes);
+      EXPECT_EQ(w.node_of(r), j) << "child " << c << " of node " << i;
+      const WideHeader& hd = w.headers[j];
+      if (r & kWideRefLeaf && r & kWideRefPack) {
+        ++pack_refs;
+        EXPECT_EQ(hd.leaf, kWideTriangleLeaf);
+        EXPECT_EQ(wide_ref_pack(r), hd.block);
+        EXPECT_EQ(wide_ref_pack_count(r), hd.count);
+        EXPECT_EQ(w.pack_first(r), hd.first);
+      } else if (r & kWideRefLeaf) {
+        ++node_refs;
+        EXPECT_NE(hd.leaf, kWideTriangleLeaf);  // four triangles at most: one pack
+      }
+    }
+  }
+  EXPECT_GT(pack_refs, 100u);
+  EXPECT_GT(node_refs, 0u);  // the mixed leaves
+}
+
 TEST(PrimitiveStore, AnEditedStoreReadsItsEdits) {
   std::vector<Surface> mats(5);
   ExplicitHierarchy h = build_explicit(mixed(), mats);

@@ -96,9 +96,23 @@ void build_wide(ExplicitHierarchy& h) {
   // The triangle leaves' packs, in node order; the primitives keep only what the packs lack.
   std::vector<std::uint32_t> first_pack(leaves.size());
   h.prims.pack(leaves, first_pack);
+  w.pack_node.assign(h.prims.packs().size(), 0);
   std::size_t k = 0;
-  for (WideHeader& hd : w.headers)
-    if (hd.leaf == kWideTriangleLeaf) hd.block = first_pack[k++];
+  for (std::size_t i = 0; i < n; ++i) {
+    WideHeader& hd = w.headers[i];
+    if (hd.leaf != kWideTriangleLeaf) continue;
+    hd.block = first_pack[k++];
+    const std::uint32_t packs = (hd.count + kWideLanes - 1) / kWideLanes;
+    for (std::uint32_t p = 0; p < packs; ++p)
+      w.pack_node[hd.block + p] = static_cast<std::uint32_t>(i);
+  }
+  // A leaf of one pack is referred to by its pack (hierarchy/wide.h).
+  const auto leaf_ref = [&](std::uint32_t j) {
+    const WideHeader& hd = w.headers[j];
+    if (hd.leaf == kWideTriangleLeaf && hd.count <= kWideLanes && hd.block < kWideMaxPackRefs)
+      return wide_pack_ref(hd.block, hd.count);
+    return kWideRefLeaf | j;
+  };
   // No records though the root is interior: more than references address (the generic walk).
   if (n_records == 0 && n > 0 && !h.nodes[0].leaf) {
     w = WideNodes{};
@@ -106,7 +120,7 @@ void build_wide(ExplicitHierarchy& h) {
   }
   const auto ref = [&](std::uint32_t j) {
     const ExplicitNode& c = h.nodes[j];
-    return c.leaf ? kWideRefLeaf | j : interior_ref(w.headers[j].block, c.count);
+    return c.leaf ? leaf_ref(j) : interior_ref(w.headers[j].block, c.count);
   };
   allocate(w, n_records);
   for_each_index(n, [&](std::size_t i) {

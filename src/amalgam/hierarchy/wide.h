@@ -51,7 +51,11 @@ struct WideHeader {
 ///
 /// A reference to a node, as a parent's record holds it for each child and the traversal's
 /// stack carries it (so that entering a child needs nothing but its reference):
-/// - a leaf: kWideRefLeaf | its node id (its header says what it holds);
+/// - a triangle-only leaf of one pack (1 to 4 triangles: the default leaves): kWideRefLeaf |
+///   kWideRefPack | (count - 1) << 28 | the index of its pack in the primitive store, so that
+///   the walk tests the pack without reading the leaf's header first (on a 10^6-triangle scene
+///   that read was a second dependent cache miss per leaf); `pack_node` gives its node;
+/// - any other leaf: kWideRefLeaf | its node id (its header says what it holds);
 /// - an interior node: half the byte offset of its record in `WideNodes::pool` (records are
 ///   32-byte aligned, so the low 4 bits are free) | a lane code there: its child count when at
 ///   most 8 (the lanes in use: (1 << code) - 1), else kWideRefMany (the count is in its
@@ -60,13 +64,29 @@ struct WideHeader {
 /// top leaf's reference, whose record's lanes are instances (their instance indices).
 using WideRef = std::uint32_t;
 inline constexpr WideRef kWideRefLeaf = 1u << 31;
+inline constexpr WideRef kWideRefPack = 1u << 30;  ///< with kWideRefLeaf: a one-pack leaf
+inline constexpr WideRef kWideRefPackIndex = (1u << 28) - 1;
 inline constexpr WideRef kWideRefMany = 15;
 inline constexpr WideRef kWideRefOffset = ~kWideRefLeaf & ~15u;
+/// Packs a one-pack leaf's reference can address.
+inline constexpr std::uint64_t kWideMaxPackRefs = std::uint64_t{kWideRefPackIndex} + 1;
+
+/// The reference of a one-pack leaf of `count` (1..4) triangles in pack `pack`.
+inline constexpr WideRef wide_pack_ref(std::uint32_t pack, int count) {
+  return kWideRefLeaf | kWideRefPack | static_cast<WideRef>(count - 1) << 28 | pack;
+}
+/// The pack and the number of triangles of a one-pack leaf's reference.
+inline constexpr std::uint32_t wide_ref_pack(WideRef r) {
+  return r & kWideRefPackIndex;
+}
+inline constexpr int wide_ref_pack_count(WideRef r) {
+  return static_cast<int>((r >> 28) & 3u) + 1;
+}
 /// The bytes of a record.
 inline constexpr std::uint32_t kWideRecordBytes = 7 * kBoxLanes * sizeof(float);
 /// The largest node id (leaf) and pool size a reference can hold; larger hierarchies take the
 /// generic traversal.
-inline constexpr std::uint64_t kWideMaxNodes = kWideRefLeaf;
+inline constexpr std::uint64_t kWideMaxNodes = kWideRefPack;
 inline constexpr std::uint64_t kWideMaxPoolBytes = std::uint64_t{kWideRefLeaf} * 2;
 
 inline constexpr WideRef wide_interior_ref(std::uint64_t offset, int count) {
@@ -100,7 +120,10 @@ struct WideNodes {
   std::vector<WideHeader> headers;         ///< one per node
   std::vector<WideUnit> pool;              ///< interior nodes' records, in node order
   std::vector<std::uint32_t> record_node;  ///< per record: its node (LOD policies read it)
-  WideRef root = 0;                        ///< the reference of node 0
+  /// Per pack of the primitive store: the leaf it belongs to (one-pack leaves' references
+  /// carry their pack, not their node; LOD policies and a hit's primitive id read it).
+  std::vector<std::uint32_t> pack_node;
+  WideRef root = 0;  ///< the reference of node 0
   const unsigned char* pool_bytes() const {
     return reinterpret_cast<const unsigned char*>(pool.data());
   }
@@ -113,8 +136,11 @@ struct WideNodes {
   /// The id of the node `r` refers to (in a hierarchy's own tree: there kWideRefLeaf marks a
   /// leaf).
   std::uint32_t node_of(WideRef r) const {
-    return r & kWideRefLeaf ? r & ~kWideRefLeaf : record_owner(r);
+    if (!(r & kWideRefLeaf)) return record_owner(r);
+    return r & kWideRefPack ? pack_node[wide_ref_pack(r)] : r & ~kWideRefLeaf;
   }
+  /// The first primitive of the one-pack leaf `r`.
+  std::uint32_t pack_first(WideRef r) const { return headers[pack_node[wide_ref_pack(r)]].first; }
   /// The children of interior node `r`.
   int child_count(WideRef r) const {
     const int code = static_cast<int>(r & 15u);
@@ -122,7 +148,7 @@ struct WideNodes {
   }
   std::size_t bytes() const {
     return headers.size() * sizeof(WideHeader) + pool.size() * sizeof(WideUnit) +
-           record_node.size() * sizeof(std::uint32_t);
+           (record_node.size() + pack_node.size()) * sizeof(std::uint32_t);
   }
 };
 
