@@ -141,6 +141,19 @@ struct WideNodes {
   }
   /// The first primitive of the one-pack leaf `r`.
   std::uint32_t pack_first(WideRef r) const { return headers[pack_node[wide_ref_pack(r)]].first; }
+  /// What the walks read of leaf `r` before testing it: a one-pack leaf's pack and count from
+  /// the reference alone (`first` left 0: `leaf_first` reads it, on a hit), any other leaf's
+  /// header.
+  WideHeader leaf_header(WideRef r) const {
+    if (r & kWideRefPack)
+      return {0, wide_ref_pack(r), static_cast<std::uint16_t>(wide_ref_pack_count(r)),
+              kWideTriangleLeaf, 0};
+    return headers[r & ~kWideRefLeaf];
+  }
+  /// The first primitive of leaf `r`, whose `leaf_header` is `hd`.
+  std::uint32_t leaf_first(WideRef r, const WideHeader& hd) const {
+    return r & kWideRefPack ? pack_first(r) : hd.first;
+  }
   /// The children of interior node `r`.
   int child_count(WideRef r) const {
     const int code = static_cast<int>(r & 15u);

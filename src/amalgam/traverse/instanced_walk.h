@@ -133,21 +133,13 @@ class InstancedWalk {
     const WideNodes& w = mesh.wide;
     const int cl = it.level + 1;
     if (it.ref & kWideRefLeaf) {
-      // A one-pack leaf from its reference alone, another from its header (as WideWalk).
       const WideRef r = it.ref;
-      WideHeader hd{};
-      if (r & kWideRefPack) {
-        hd = {0, wide_ref_pack(r), static_cast<std::uint16_t>(wide_ref_pack_count(r)),
-              kWideTriangleLeaf, 0};
-      } else {
-        hd = w.headers[r & ~kWideRefLeaf];
-      }
+      const WideHeader hd = w.leaf_header(r);
       if (hd.leaf == kWideTriangleLeaf) {
         const WideRay& owr = in.identity ? wr : object_ray(s, in, inst);
         PackLeaf<State>::test(
             s, mesh.prims.packs().data() + hd.block, owr,
-            [&] { return IH::id(inst, r & kWideRefPack ? w.pack_first(r) : hd.first); }, hd.count,
-            cl);
+            [&] { return IH::id(inst, w.leaf_first(r, hd)); }, hd.count, cl);
         return s.done ? Next::kStop : Next::kPop;
       }
       for (int i = 0; i < hd.count; ++i) {  // spheres or boxes: the generic path's test

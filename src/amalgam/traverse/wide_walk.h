@@ -138,7 +138,7 @@ class WideWalk {
     // The per-ray constants and the stack's base and capacity as locals: members would be
     // reloaded after every store to the stack (a float store may alias them).
     const WideRay wr = WideRay::of(s.ray);
-    const Arrays arr{w.headers.data(), w.pool_bytes(), s.h.prims.packs().data(), &w};
+    const Arrays arr{w.pool_bytes(), s.h.prims.packs().data(), &w};
     StackItem* st = stack_.data();
     std::size_t cap = stack_.size(), sp = 0;
     StackItem it = st[0];
@@ -154,9 +154,9 @@ class WideWalk {
   }
 
   /// The node arrays' bases as the loop's locals (read through `WideNodes`, they were loaded
-  /// again at every node: a store to the stack may alias them).
+  /// again at every node: a store to the stack may alias them); the leaves' headers, read only
+  /// for leaves that are not one-pack leaves, through `nodes`.
   struct Arrays {
-    const WideHeader* headers;
     const unsigned char* pool;
     const TrianglePack4* tris;
     const WideNodes* nodes;
@@ -181,30 +181,22 @@ class WideWalk {
     const WideRef ref = it.ref;
     const int cl = it.level + 1;
     if (ref & kWideRefLeaf) {
-      // A one-pack leaf (the default leaves) from its reference alone; another leaf from its
-      // header. One call of the pack test for both (two inlined copies made the loop a third
-      // larger and small scenes 5-15 % slower).
-      const TrianglePack4* pack;
-      int n;
-      std::uint32_t first = 0;
-      if (ref & kWideRefPack) {
-        pack = w.tris + wide_ref_pack(ref), n = wide_ref_pack_count(ref);
-      } else {
-        const WideHeader hd = w.headers[ref & ~kWideRefLeaf];
-        if (hd.leaf != kWideTriangleLeaf) [[unlikely]] {
-          for (int i = 0; i < hd.count; ++i) {
-            s.counters.count_test(s.kind, ObjectKind::kPrimitive, cl);
-            primitive(s, wr.pre, hd.first + static_cast<std::uint32_t>(i), cl);
-            if (s.done) return Next::kStop;
-          }
-          return Next::kPop;
-        }
-        pack = w.tris + hd.block, n = hd.count, first = hd.first;
+      // A one-pack leaf (the default leaves) from its reference alone, another leaf from its
+      // header (WideNodes::leaf_header). One call of the pack test for both (two inlined copies
+      // made the loop a third larger and small scenes 5-15 % slower).
+      const WideHeader hd = w.nodes->leaf_header(ref);
+      if (hd.leaf == kWideTriangleLeaf) [[likely]] {
+        PackLeaf<State>::test(
+            s, w.tris + hd.block, wr, [&] { return PrimId{w.nodes->leaf_first(ref, hd)}; },
+            hd.count, cl);
+        return s.done ? Next::kStop : Next::kPop;
       }
-      PackLeaf<State>::test(
-          s, pack, wr,
-          [&] { return PrimId{ref & kWideRefPack ? w.nodes->pack_first(ref) : first}; }, n, cl);
-      return s.done ? Next::kStop : Next::kPop;
+      for (int i = 0; i < hd.count; ++i) {
+        s.counters.count_test(s.kind, ObjectKind::kPrimitive, cl);
+        primitive(s, wr.pre, hd.first + static_cast<std::uint32_t>(i), cl);
+        if (s.done) return Next::kStop;
+      }
+      return Next::kPop;
     }
     const int count = static_cast<int>(ref & 15u);
     if (count > kBoxLanes) [[unlikely]]
