@@ -7,9 +7,13 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <random>
 #include <set>
 #include <vector>
 
+#include "amalgam/geometry/intersect.h"
+#include "amalgam/hierarchy/bake/combine.h"
 #include "amalgam/hierarchy/bake/lines.h"
 #include "amalgam/hierarchy/build/build.h"
 #include "amalgam/hierarchy/build/sah.h"
@@ -154,6 +158,67 @@ TEST(BakeLines, UniformsAreTheSamplersDraws) {
         }
       }
     }
+}
+
+// The bake's test of a line against a node's children four at a time gives, lane by lane, the
+// scalar intersect_box's hit and entry bit for bit: random boxes and rays with shared and
+// signed zero coordinates, infinities, NaN, flat and empty boxes, zero direction components
+// (containment tests), tmin and tmax other than [0, inf), and 1 to 64 children.
+TEST(BakeChildren, BoxEntriesMatchTheScalarTest) {
+  std::mt19937_64 rng(0xb0c5);
+  std::uniform_real_distribution<float> uniform(-2.0f, 2.0f);
+  std::uniform_int_distribution<int> pick(0, 99);
+  const float inf = std::numeric_limits<float>::infinity();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  auto value = [&](float shared) {
+    const int c = pick(rng);
+    return c < 3    ? 0.0f
+           : c < 5  ? -0.0f
+           : c < 6  ? inf
+           : c < 7  ? -inf
+           : c < 8  ? nan
+           : c < 20 ? shared
+                    : uniform(rng);
+  };
+  std::vector<BakeChild> kids(kMaxChildren);
+  std::uint64_t lanes = 0, hits = 0, flat_hits = 0;
+  for (int it = 0; it < 100000; ++it) {
+    const int count = 1 + pick(rng) % (it % 10 == 0 ? kMaxChildren : 9);
+    const float shared = uniform(rng);
+    for (int k = 0; k < count; ++k) {
+      Bbox b;
+      for (int a = 0; a < 3; ++a) {
+        float x = value(shared), y = value(shared);
+        if (pick(rng) < 80 && x > y) std::swap(x, y);
+        if (pick(rng) < 10) y = x;
+        b.lo[a] = x, b.hi[a] = y;
+      }
+      if (pick(rng) < 3) b = Bbox{};
+      kids[static_cast<std::size_t>(k)].bounds = b;
+    }
+    const Vec3 o{value(shared), value(shared), value(shared)};
+    const Vec3 d{value(0.0f), value(0.0f), value(0.0f)};
+    const Ray ray =
+        Ray::make(o, d, pick(rng) < 80 ? 0.0f : value(0.5f), pick(rng) < 80 ? inf : value(1.0f));
+    const ChildBoxes boxes(
+        std::span<const BakeChild>(kids.data(), static_cast<std::size_t>(count)));
+    alignas(16) float t0[kMaxChildren];
+    const std::uint64_t mask = boxes.entries(ray, t0);
+    for (int k = 0; k < count; ++k) {
+      const Bbox& b = kids[static_cast<std::size_t>(k)].bounds;
+      float s0 = 0, s1 = 0;
+      const bool hit = intersect_box(ray, b, s0, s1);
+      ++lanes;
+      ASSERT_EQ(hit, ((mask >> k) & 1u) != 0) << it << " child " << k;
+      if (!hit) continue;
+      ++hits;
+      if (b.lo.x == b.hi.x || b.lo.y == b.hi.y || b.lo.z == b.hi.z) ++flat_hits;
+      ASSERT_EQ(std::memcmp(&s0, &t0[k], sizeof s0), 0)
+          << it << " child " << k << ": " << s0 << " vs " << t0[k];
+    }
+  }
+  EXPECT_GT(hits, lanes / 20);  // the cases test hits, not only misses
+  EXPECT_GT(flat_hits, 1000u);
 }
 
 }  // namespace

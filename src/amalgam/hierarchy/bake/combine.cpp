@@ -1,8 +1,10 @@
 #include "amalgam/hierarchy/bake/combine.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
+#include "amalgam/geometry/intersect.h"
 #include "amalgam/hierarchy/bake/lines.h"
 #include "amalgam/hierarchy/hierarchy.h"
 #include "amalgam/util/check.h"
@@ -15,6 +17,19 @@ void orient(BakeResult& r, Vec3 outward, float weight) {
   if (!(std::fabs(along) >= 0.5f)) return;
   if (along < 0.0f) r.app.normal = -r.app.normal;
   r.app.shading = Shading::kOriented;
+}
+
+ChildBoxes::ChildBoxes(std::span<const BakeChild> kids) : count_(static_cast<int>(kids.size())) {
+  AMALGAM_CHECK(kids.size() <= static_cast<std::size_t>(kMaxChildren),
+                "ChildBoxes: more children than kMaxChildren");
+  for (int k = 0; k < (count_ + 3) / 4 * 4; ++k) {
+    // Lanes beyond the children hold the empty box; the caller masks them out.
+    const Bbox b = k < count_ ? kids[static_cast<std::size_t>(k)].bounds : Bbox{};
+    for (int a = 0; a < 3; ++a) {
+      groups_[k / 4].lo[a][k % 4] = b.lo[a];
+      groups_[k / 4].hi[a][k % 4] = b.hi[a];
+    }
+  }
 }
 
 namespace {
@@ -61,18 +76,21 @@ BakeResult bake_from_children(const Bbox& box, std::span<const BakeChild> kids, 
                 "bake_from_children: more children than kMaxChildren");
   rays = std::max(rays, 1);
   const LineSampler lines(box);
+  const ChildBoxes boxes(kids);
+  std::uint64_t seen = 0;  // the children that can stop a line
+  for (int k = 0; k < static_cast<int>(kids.size()); ++k)
+    if (kids[k].app.opacity > 0.0f) seen |= std::uint64_t{1} << k;
+  alignas(16) float t0[(kMaxChildren + 3) / 4 * 4];
   for (int r = 0; r < rays; ++r) {
     float u[6];
     line_uniforms(key, r, rays, u);
     const Ray ray = lines(u);
     int n = 0;
-    for (int k = 0; k < static_cast<int>(kids.size()); ++k) {
-      if (!(kids[k].app.opacity > 0.0f)) continue;
-      const auto span = intersect_box(ray, kids[k].bounds);
-      if (!span) continue;
+    for (std::uint64_t m = boxes.entries(ray, t0) & seen; m; m &= m - 1) {
+      const int k = std::countr_zero(m);
       int i = n++;
-      while (i > 0 && entries[i - 1].t > span->t0) entries[i] = entries[i - 1], --i;
-      entries[i] = {span->t0, k};
+      while (i > 0 && entries[i - 1].t > t0[k]) entries[i] = entries[i - 1], --i;
+      entries[i] = {t0[k], k};
     }
     float through = 1.0f;
     for (int i = 0; i < n && through > 0.0f; ++i) {
