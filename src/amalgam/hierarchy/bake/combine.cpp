@@ -72,11 +72,9 @@ BakeResult bake_from_children(const Bbox& box, std::span<const BakeChild> kids, 
   NormalTensor normals;
   Vec3 outward{};
   bool oriented = true;  // every child seen has an outward normal
-  AMALGAM_CHECK(kids.size() <= static_cast<std::size_t>(kMaxChildren),
-                "bake_from_children: more children than kMaxChildren");
   rays = std::max(rays, 1);
   const LineSampler lines(box);
-  const ChildBoxes boxes(kids);
+  const ChildBoxes boxes(kids);  // checks that `entries` has room for every child
   std::uint64_t seen = 0;  // the children that can stop a line
   for (int k = 0; k < static_cast<int>(kids.size()); ++k)
     if (kids[k].app.opacity > 0.0f) seen |= std::uint64_t{1} << k;
