@@ -1,10 +1,12 @@
 #pragma once
 // What the end-to-end tests of the `amalgam` binary share: running a shell command with its
-// stdout captured, reading a file whole, and a scratch directory per test process.
+// stdout captured, reading a file whole, a scratch directory per test process, and the sample
+// count an interrupted render reports.
 
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -53,6 +55,29 @@ inline std::filesystem::path scratch_dir(const std::string& prefix) {
     s.dir = std::filesystem::temp_directory_path() / (prefix + "-" + std::to_string(getpid()));
   std::filesystem::create_directories(s.dir);
   return s.dir;
+}
+
+/// "... holds N of M samples per pixel ..." in an interrupted render's stderr -> N (-1 if
+/// absent). Parsed by hand, not with std::regex: GCC 12 warns inside <regex> under the
+/// sanitizers (-Wmaybe-uninitialized in std::function).
+inline int samples_held(const std::string& err) {
+  const auto digits = [&](std::size_t& i) {
+    const std::size_t from = i;
+    while (i < err.size() && std::isdigit(static_cast<unsigned char>(err[i]))) ++i;
+    return i > from;
+  };
+  const std::string head = "holds ", of = " of ", tail = " samples per pixel";
+  for (std::size_t at = err.find(head); at != std::string::npos; at = err.find(head, at + 1)) {
+    std::size_t i = at + head.size();
+    const std::size_t n = i;
+    if (!digits(i)) continue;
+    const std::size_t n_end = i;
+    if (err.compare(i, of.size(), of) != 0) continue;
+    i += of.size();
+    if (!digits(i) || err.compare(i, tail.size(), tail) != 0) continue;
+    return std::stoi(err.substr(n, n_end - n));
+  }
+  return -1;
 }
 
 }  // namespace amalgam::test

@@ -18,17 +18,19 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "cli_support.h"
 
 extern char** environ;
 
 namespace {
 
 namespace fs = std::filesystem;
+using amalgam::test::samples_held;
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -107,14 +109,6 @@ bool wait_for(const fs::path& file, pid_t pid) {
 std::size_t pfm_size(int w, int h) {
   const std::string header = "PF\n" + std::to_string(w) + " " + std::to_string(h) + "\n-1.0\n";
   return header.size() + static_cast<std::size_t>(w) * h * 12;
-}
-
-/// "holds N of M samples per pixel" -> N (-1 if absent).
-int samples_held(const std::string& err) {
-  std::smatch m;
-  if (std::regex_search(err, m, std::regex("holds ([0-9]+) of [0-9]+ samples per pixel")))
-    return std::stoi(m[1]);
-  return -1;
 }
 
 const std::string kRender =

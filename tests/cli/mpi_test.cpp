@@ -30,6 +30,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using amalgam::test::run_command;
+using amalgam::test::samples_held;
 using amalgam::test::slurp;
 
 #if defined(AMALGAM_MPIEXEC)
@@ -120,18 +121,6 @@ pid_t rank_pid(pid_t mpirun_pid, int rank) {
       return c;
   }
   return -1;
-}
-
-/// "holds N of M samples per pixel" -> N (-1 if absent). (No std::regex: GCC 12 warns inside
-/// it under the sanitizers.)
-int samples_held(const std::string& err) {
-  const std::size_t at = err.find(" holds ");
-  if (at == std::string::npos) return -1;
-  std::istringstream in(err.substr(at + 7));
-  int held = -1;
-  std::string of;
-  if (!(in >> held >> of) || of != "of") return -1;
-  return held;
 }
 
 /// The counts of a stats JSON: everything but times, memory, the command line and the
