@@ -17,7 +17,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -31,11 +30,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using amalgam::test::samples_held;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using amalgam::test::slurp;
 
 /// A fresh directory per test.
 struct Dir {
