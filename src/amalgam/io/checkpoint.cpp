@@ -17,9 +17,10 @@ namespace amalgam {
 namespace {
 
 /// The format version is the last part of the magic; version 3 added the auxiliary outputs
-/// (PixelAov) after the tests per pixel; version 4 the `reached` counters of Counters.
+/// (PixelAov) after the tests per pixel; version 4 the `reached` counters of Counters; version 5
+/// the cell tests of volumetric amalgams (ObjectKind::kCell).
 constexpr char kMagicPrefix[] = "AMALGAM-CHECKPOINT-";
-constexpr char kMagic[] = "AMALGAM-CHECKPOINT-4";
+constexpr char kMagic[] = "AMALGAM-CHECKPOINT-5";
 
 /// Checksum of a checkpoint's bytes (everything before the checksum itself): 64-bit words
 /// through hash_combine, so any flipped bit changes it (with probability 1 - 2^-64).
@@ -94,7 +95,7 @@ FilmState read_checkpoint(const std::string& path, const std::string& fingerprin
            ++i)
         format += bytes[i];
       throw InputError(path + ": checkpoint of another amalgam version (format " + format +
-                       ", this one reads format 4): delete it and render again");
+                       ", this one reads format 5): delete it and render again");
     }
     throw InputError(path + ": not an amalgam checkpoint");
   }

@@ -22,9 +22,11 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
   using nlohmann::json;
   const HierarchyInfo info = scene.info();
   json j;
-  j["renderer"] = o.renderer == RendererKind::kTraditional ? "traditional" : "scale-sensitive";
+  j["renderer"] = o.renderer == RendererKind::kTraditional  ? "traditional"
+                  : o.renderer == RendererKind::kVolumetric ? "volumetric"
+                                                            : "scale-sensitive";
   j["opacity"] = std::string(opacity_name(o.opacity));
-  const bool ss = o.renderer == RendererKind::kScaleSensitive;
+  const bool ss = o.renderer != RendererKind::kTraditional;
   j["level"] = (ss && o.level) ? json(*o.level) : json(nullptr);
   j["footprint"] = (ss && !o.level) ? json(o.footprint) : json(nullptr);
   j["order"] = o.sorted ? "sorted" : "unsorted";
@@ -32,6 +34,11 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
   j["tracer"] = embree ? "embree" : "amalgam";
   j["seed"] = o.seed;
   j["sampler"] = o.sampler == PixelSampler::kStratified ? "stratified" : "independent";
+  if (scene.volumes)
+    j["volumes"] = {{"cells", scene.volumes->cells()},
+                    {"bytes", scene.volumes->bytes()},
+                    {"levels", scene.volumes->config.levels},
+                    {"bake_s", scene.volume_seconds}};
   j["scene"] = {{"name", scene.name},
                 {"primitives", count(info.primitives)},
                 {"nodes", count(info.nodes)},
@@ -49,6 +56,7 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
                 {"primitive", c.tests_of(ObjectKind::kPrimitive)},
                 {"bounding_volume", c.tests_of(ObjectKind::kBoundingVolume)},
                 {"amalgam", c.tests_of(ObjectKind::kAmalgam)},
+                {"cell", c.tests_of(ObjectKind::kCell)},
                 {"by_level", by_level}};
   // The paper's counting (Eq. 4, Figure 4): nodes reached in sorted order plus primitives
   // tested; `tests` counts every child of an entered node.

@@ -9,16 +9,23 @@
 namespace amalgam {
 
 enum class RayKind : std::uint8_t { kPrimary = 0, kShadow = 1 };
-/// What was tested: a primitive; a node tested only as a container (bounding volume); or a
-/// node the renderer may render (amalgam).
-enum class ObjectKind : std::uint8_t { kPrimitive = 0, kBoundingVolume = 1, kAmalgam = 2 };
+/// What was tested: a primitive; a node tested only as a container (bounding volume); a
+/// node the renderer may render (amalgam); or a cell of a volumetric amalgam read by the cone
+/// march (traverse/cone_march.h: one per cell stepped through).
+enum class ObjectKind : std::uint8_t {
+  kPrimitive = 0,
+  kBoundingVolume = 1,
+  kAmalgam = 2,
+  kCell = 3
+};
+inline constexpr int kObjectKinds = 4;
 
 /// Levels counted separately (`by_level`); deeper tests are counted on the last one.
 inline constexpr int kCountedLevels = 64;
 
 struct Counters {
   /// tests[ray kind][object kind]
-  std::array<std::array<std::uint64_t, 3>, 2> tests{};
+  std::array<std::array<std::uint64_t, kObjectKinds>, 2> tests{};
   std::array<std::uint64_t, kCountedLevels> by_level{};
   std::array<std::uint64_t, 2> rays{};
   /// Nodes (bounding volumes and amalgams) a traversal reached -- took from its sorted list
@@ -52,7 +59,7 @@ struct Counters {
 
   std::uint64_t tests_of(RayKind r) const {
     const auto& t = tests[static_cast<int>(r)];
-    return t[0] + t[1] + t[2];
+    return t[0] + t[1] + t[2] + t[3];
   }
   std::uint64_t tests_of(ObjectKind o) const {
     return tests[0][static_cast<int>(o)] + tests[1][static_cast<int>(o)];
@@ -61,7 +68,7 @@ struct Counters {
 
   void merge(const Counters& o) {
     for (int r = 0; r < 2; ++r)
-      for (int k = 0; k < 3; ++k) tests[r][k] += o.tests[r][k];
+      for (int k = 0; k < kObjectKinds; ++k) tests[r][k] += o.tests[r][k];
     for (int l = 0; l < kCountedLevels; ++l) by_level[l] += o.by_level[l];
     for (int r = 0; r < 2; ++r) rays[r] += o.rays[r], reached[r] += o.reached[r];
   }
