@@ -66,9 +66,9 @@ Options make_options(int width, int height, int spp, const std::string& renderer
                      std::optional<float> footprint, const std::string& order, std::uint64_t seed,
                      int threads, const std::string& sampler = "independent") {
   // The checks and messages of the CLI (apps/amalgam/common.cpp, CommonOptions::finish).
-  if (renderer != "scale-sensitive" && renderer != "traditional")
+  if (renderer != "scale-sensitive" && renderer != "traditional" && renderer != "volumetric")
     throw InputError("--renderer " + one_line(renderer, 40) +
-                     ": expected scale-sensitive or traditional");
+                     ": expected scale-sensitive, traditional or volumetric");
   if (!parse_opacity(opacity))
     throw InputError("--opacity " + one_line(opacity, 40) +
                      ": expected stochastic, deterministic, prefiltered or composite");
@@ -79,6 +79,8 @@ Options make_options(int width, int height, int spp, const std::string& renderer
   if (renderer == "traditional" && (level || footprint))
     throw InputError(std::string("--renderer traditional renders no amalgam: ") +
                      (level ? "--level" : "--footprint") + " does not apply");
+  if (renderer == "volumetric" && level)
+    throw InputError("--renderer volumetric chooses cells by footprint: --level does not apply");
   if (level && *level < 0)
     throw InputError("--level " + std::to_string(*level) + ": expected an integer >= 0");
   if (footprint && !(*footprint > 0.0f && *footprint < 1e30f))
@@ -93,8 +95,9 @@ Options make_options(int width, int height, int spp, const std::string& renderer
   if (sampler != "independent" && sampler != "stratified")
     throw InputError("--sampler " + one_line(sampler, 40) + ": expected independent or stratified");
   Options r;
-  r.o.renderer =
-      renderer == "traditional" ? RendererKind::kTraditional : RendererKind::kScaleSensitive;
+  r.o.renderer = renderer == "traditional"  ? RendererKind::kTraditional
+                 : renderer == "volumetric" ? RendererKind::kVolumetric
+                                            : RendererKind::kScaleSensitive;
   r.o.opacity = *parse_opacity(opacity);
   r.o.level = level;
   r.o.footprint = footprint ? *footprint : 1.0f;
@@ -223,18 +226,16 @@ struct Scene {
                                        const std::string& opacity, std::optional<int> level,
                                        std::optional<float> footprint, const std::string& order,
                                        std::uint64_t seed, int threads, const std::string& sampler,
-                                       const py::object& camera,
-                                       const py::object& eye, const py::object& look_at,
-                                       const py::object& up, const py::object& fov,
-                                       const py::object& light_samples) {
-    const Options opt =
-        make_options(width, height, spp, renderer, opacity, level, footprint, order, seed, threads,
-                     sampler);
+                                       const py::object& camera, const py::object& eye,
+                                       const py::object& look_at, const py::object& up,
+                                       const py::object& fov, const py::object& light_samples) {
+    const Options opt = make_options(width, height, spp, renderer, opacity, level, footprint, order,
+                                     seed, threads, sampler);
     check_options(*scene, opt.o);
     // Another view of the same built, baked scene: only the environment is new.
     CameraChoice view;
     const std::pair<const char*, const py::object*> keys[] = {
-        {"camera", &camera}, {"eye", &eye},  {"look_at", &look_at},
+        {"camera", &camera}, {"eye", &eye}, {"look_at", &look_at},
         {"up", &up},         {"fov", &fov}, {"light_samples", &light_samples}};
     for (const auto& [key, value] : keys)
       if (!value->is_none()) view_keyword(key, *value, view);
@@ -318,15 +319,20 @@ std::shared_ptr<Scene> load(const std::string& spec, const py::kwargs& params) {
   // the others are builtin parameters (--set key=value).
   Params p(spec);
   CameraChoice view;
+  SceneFileConfig config;
   for (auto item : params) {
     const std::string key = py::str(item.first).cast<std::string>();
+    if (key == "volumetric") {  // load for the volumetric renderer (--renderer volumetric)
+      config.objects = py::cast<bool>(item.second);
+      continue;
+    }
     if (!view_keyword(key, item.second, view)) p.set(key, py::str(item.second).cast<std::string>());
   }
   auto s = std::make_shared<Scene>();
   s->spec = spec;
   {
     py::gil_scoped_release nogil;
-    LoadedScene loaded = load_scene(spec, p);
+    LoadedScene loaded = load_scene(spec, p, config);
     choose_camera(loaded, view);
     s->scene = std::make_shared<const LoadedScene>(std::move(loaded));
   }
@@ -513,7 +519,8 @@ PYBIND11_MODULE(amalgam, m) {
         "arguments (the CLI's --set key=value, e.g. load('builtin:line', n=4)), a scene .json,\n"
         "or a mesh path. The view keywords camera= (name or index), eye=, look_at=, up=\n"
         "(x, y, z) and fov= (degrees) are the CLI's --camera, --eye, --look-at, --up, --fov.\n"
-        "Raises ValueError with the CLI's message on bad input.");
+        "volumetric=True loads it for renderer='volumetric' (every mesh an object with its\n"
+        "volumetric amalgams baked). Raises ValueError with the CLI's message on bad input.");
   m.def("compare", &compare, py::arg("a"), py::arg("b"),
         "compare(a, b) -> dict\n\n"
         "Image metrics of `amalgam compare` for two H x W x 3 images (arrays or RenderResults),\n"

@@ -13,8 +13,10 @@ void CommonOptions::add_to(CLI::App& app) {
   app.add_option("scene", scene, "builtin:NAME, a scene .json or a mesh file")->required();
   app.add_option("--set", sets, "builtin scene parameter key=value (repeatable)");
   renderer_option =
-      app.add_option("--renderer", renderer, "scale-sensitive (default) or traditional")
-          ->check(CLI::IsMember({"scale-sensitive", "traditional"}));
+      app.add_option("--renderer", renderer,
+                     "scale-sensitive (default), traditional, or volumetric (objects as "
+                     "prefiltered cells where the cone is wide enough, docs/volumetric.md)")
+          ->check(CLI::IsMember({"scale-sensitive", "traditional", "volumetric"}));
   opacity_option =
       app.add_option("--opacity", opacity,
                      "stochastic (default), deterministic, prefiltered (stochastic for camera "
@@ -77,8 +79,11 @@ void CommonOptions::finish() {
   if (renderer == "traditional" && (level_given || footprint_given))
     throw InputError(std::string("--renderer traditional renders no amalgam: ") +
                      (level_given ? "--level" : "--footprint") + " does not apply");
-  options.renderer =
-      renderer == "traditional" ? RendererKind::kTraditional : RendererKind::kScaleSensitive;
+  if (renderer == "volumetric" && level_given)
+    throw InputError("--renderer volumetric chooses cells by footprint: --level does not apply");
+  options.renderer = renderer == "traditional"  ? RendererKind::kTraditional
+                     : renderer == "volumetric" ? RendererKind::kVolumetric
+                                                : RendererKind::kScaleSensitive;
   options.tracer = tracer == "embree" ? TracerKind::kEmbree : TracerKind::kAmalgam;
   if (options.tracer == TracerKind::kEmbree) {
 #if !defined(AMALGAM_HAVE_EMBREE)

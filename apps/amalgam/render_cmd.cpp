@@ -172,7 +172,7 @@ std::string options_text(const CommonOptions& c, int spp) {
   const RenderOptions& o = c.options;
   std::ostringstream f;
   f << "--renderer " << c.renderer << " --opacity " << c.opacity << " --order " << c.order;
-  if (o.renderer == RendererKind::kScaleSensitive) {
+  if (o.renderer != RendererKind::kTraditional) {
     if (o.level)
       f << " --level " << *o.level;
     else
@@ -239,6 +239,7 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
     budget.max_bytes = limit - film;
     budget.limit_name = "--max-memory " + format_bytes(static_cast<double>(limit)) + " less " +
                         format_bytes(static_cast<double>(film)) + " for the film";
+    budget.objects = o.renderer == RendererKind::kVolumetric;
     budget.on_phase = [&](const std::string& what) {
       set_activity(what);
       status.phase(what);
@@ -447,7 +448,9 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
 int run_trace(CommonOptions& common, const std::string& origin, const std::string& direction) {
   common.finish();
   set_activity("loading and building " + common.scene);
-  LoadedScene scene = load_scene(common.scene, common.params());
+  SceneFileConfig config;
+  config.objects = common.options.renderer == RendererKind::kVolumetric;
+  LoadedScene scene = load_scene(common.scene, common.params(), config);
   common.prepare(scene);
   print_warnings(scene);
   check_options(scene, common.options);

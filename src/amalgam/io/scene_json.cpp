@@ -73,14 +73,23 @@ class SceneParser {
     for (const Placement& p : placements)
       everything +=
           static_cast<double>(p.mesh->mesh->triangles.size()) * static_cast<double>(p.where.size());
+    // With config_.objects every mesh placed stays an object of its own (an instance).
+    const bool objects = config_.objects;
     const bool expand_all =
+        !objects &&
         everything <= static_cast<double>(std::min(config_.expand_limit, config_.max_triangles));
     std::uint64_t total = spheres.size() + boxes.size() + triangles.size();
     std::uint64_t kept = 0;
     for (const MeshEntry& m : meshes_)
-      if (placed_.count(m.name)) add_count(total, m.mesh->triangles.size(), m.ptr);
+      if (placed_.count(m.name)) {
+        if (objects)
+          ++kept;
+        else
+          add_count(total, m.mesh->triangles.size(), m.ptr);
+      }
     for (Placement& p : placements) {
-      p.expand = expand_all || p.mesh->mesh->triangles.size() < config_.instance_min_triangles;
+      p.expand = !objects &&
+                 (expand_all || p.mesh->mesh->triangles.size() < config_.instance_min_triangles);
       if (p.expand) {
         add_count(total, static_cast<double>(p.mesh->mesh->triangles.size()) * p.where.size(),
                   p.ptr);
@@ -97,6 +106,10 @@ class SceneParser {
       std::set<const MeshEntry*> seen;
       for (const Placement& p : placements)
         if (!p.expand && seen.insert(p.mesh).second) instanced += p.mesh->mesh->triangles.size();
+      if (objects)
+        for (const MeshEntry& m : meshes_)
+          if (placed_.count(m.name) && seen.insert(&m).second)
+            instanced += m.mesh->triangles.size();
       std::uint64_t textures = 0;  // texels once per file; coordinates as read and as built
       for (const auto& [file, mesh] : imported_)
         for (const Texture& t : mesh->textures) textures += t.texels.size();
@@ -109,9 +122,18 @@ class SceneParser {
     for (const JsonValue& s : spheres) read_sphere(s);
     for (const JsonValue& b : boxes) read_box(b);
     for (const JsonValue& t : triangles) read_triangle(t);
-    for (const MeshEntry& m : meshes_)
-      if (placed_.count(m.name)) place(m, Affine{}, m.material);
     Bbox bounds;
+    for (const MeshEntry& m : meshes_) {
+      if (!placed_.count(m.name)) continue;
+      if (!objects) {
+        place(m, Affine{}, m.material);
+        continue;
+      }
+      Instance in;  // identity: the mesh's own transform is in its object space
+      in.mesh = instanced_mesh(m, m.material);
+      out_.instances.push_back(in);
+      bounds.extend(object_bounds_[in.mesh]);
+    }
     for (const Placement& p : placements) {
       const auto material = p.material ? p.material : p.mesh->material;
       if (p.expand) {
@@ -364,34 +386,16 @@ class SceneParser {
     return out;
   }
 
-  static constexpr std::int64_t kMaxInstances = 100'000'000;
-
   std::vector<Affine> read_grid(const JsonValue& v, std::size_t triangles) const {
-    r_.object(v, {"nx", "nz", "spacing", "origin"});
-    const std::int64_t nx = r_.integer(r_.require(v, "nx"), 1, 1'000'000);
-    const std::int64_t nz = r_.integer(r_.require(v, "nz"), 1, 1'000'000);
-    const double spacing = r_.positive(r_.require(v, "spacing"));
-    const Vec3 origin = v.j.contains("origin") ? r_.vec3(JsonReader::child(v, "origin")) : Vec3{};
-    if (nx * nz > kMaxInstances)
-      r_.fail(v.ptr, "nx * nz = " + std::to_string(nx * nz) + " instances, more than " +
-                         std::to_string(kMaxInstances));
-    add_instances_check(static_cast<double>(nx * nz), triangles, v.ptr);
-    return grid_placements({nx, nz, spacing, origin});
+    const GridPattern grid = scene_json::read_grid(r_, v);
+    add_instances_check(static_cast<double>(grid.nx * grid.nz), triangles, v.ptr);
+    return grid_placements(grid);
   }
 
   std::vector<Affine> read_scatter(const JsonValue& v, std::size_t triangles) const {
-    r_.object(v, {"count", "radius", "seed", "centre", "center", "rotate"});
-    const std::int64_t count = r_.integer(r_.require(v, "count"), 1, kMaxInstances);
-    const double radius = r_.positive(r_.require(v, "radius"));
-    const auto seed = static_cast<std::uint64_t>(
-        v.j.contains("seed") ? r_.integer(JsonReader::child(v, "seed"), 0, INT64_MAX) : 0);
-    const Vec3 centre = [&] {
-      auto c = r_.find(v, "centre", "center");
-      return c ? r_.vec3(*c) : Vec3{};
-    }();
-    const bool rotate = v.j.contains("rotate") ? r_.boolean(JsonReader::child(v, "rotate")) : true;
-    add_instances_check(static_cast<double>(count), triangles, v.ptr);
-    return scatter_placements({count, radius, seed, centre, rotate});
+    const ScatterPattern scatter = scene_json::read_scatter(r_, v);
+    add_instances_check(static_cast<double>(scatter.count), triangles, v.ptr);
+    return scatter_placements(scatter);
   }
 
   /// Fails before the generator allocates its transforms when its instances alone would hold

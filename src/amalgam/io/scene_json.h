@@ -6,6 +6,7 @@
 #include <functional>
 #include <string>
 
+#include "amalgam/hierarchy/volume/cells.h"
 #include "amalgam/scene/description.h"
 #include "amalgam/util/error.h"
 
@@ -25,6 +26,11 @@ struct SceneFileConfig {
   std::uint64_t instance_min_triangles = 64;
   /// Instances kept as instances beyond this are an InputError (about 250 bytes each).
   std::uint64_t max_instances = 20'000'000;
+  /// Keep every mesh placed (in `meshes` or by `instances`) as an instance, never expanded:
+  /// each is then an object the volumetric renderer can render as cells (load/load_scene.h).
+  bool objects = false;
+  /// The cells baked for each object when `objects` is set (load/load_scene.h).
+  VolumeConfig volume{};
   /// Bytes the built scene may take (0: no limit), checked before any triangle is expanded or
   /// built, with MemoryModel (hierarchy/build/build.h); `limit_name` names the limit in the
   /// message (e.g. "--max-memory 100 MiB less the film").

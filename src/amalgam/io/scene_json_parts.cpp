@@ -45,7 +45,7 @@ Light read_light(const JsonReader& r, const JsonValue& l) {
     light.direction = normalize(r.direction(r.require(l, "direction")));
     if (auto x = r.find(l, "angle"))
       light.angle = static_cast<float>(r.number(*x, 1e-4, 90.0, "in degrees, (0, 90]") *
-                                        std::numbers::pi / 180.0);
+                                       std::numbers::pi / 180.0);
   } else {
     r.fail(l.ptr + "/type", "expected \"point\" or \"directional\", found \"" + type + "\"");
   }
@@ -164,6 +164,34 @@ std::uint32_t append_materials(SceneDescription& out, const ImportedMesh& mesh) 
   }
   out.textures.insert(out.textures.end(), mesh.textures.begin(), mesh.textures.end());
   return base;
+}
+
+namespace {
+constexpr std::int64_t kMaxInstances = 100'000'000;
+}  // namespace
+
+GridPattern read_grid(const JsonReader& r, const JsonValue& v) {
+  r.object(v, {"nx", "nz", "spacing", "origin"});
+  const std::int64_t nx = r.integer(r.require(v, "nx"), 1, 1'000'000);
+  const std::int64_t nz = r.integer(r.require(v, "nz"), 1, 1'000'000);
+  const double spacing = r.positive(r.require(v, "spacing"));
+  const Vec3 origin = v.j.contains("origin") ? r.vec3(JsonReader::child(v, "origin")) : Vec3{};
+  if (nx * nz > kMaxInstances)
+    r.fail(v.ptr, "nx * nz = " + std::to_string(nx * nz) + " instances, more than " +
+                      std::to_string(kMaxInstances));
+  return {nx, nz, spacing, origin};
+}
+
+ScatterPattern read_scatter(const JsonReader& r, const JsonValue& v) {
+  r.object(v, {"count", "radius", "seed", "centre", "center", "rotate"});
+  const std::int64_t count = r.integer(r.require(v, "count"), 1, kMaxInstances);
+  const double radius = r.positive(r.require(v, "radius"));
+  const auto seed = static_cast<std::uint64_t>(
+      v.j.contains("seed") ? r.integer(JsonReader::child(v, "seed"), 0, INT64_MAX) : 0);
+  auto c = r.find(v, "centre", "center");
+  const Vec3 centre = c ? r.vec3(*c) : Vec3{};
+  const bool rotate = v.j.contains("rotate") ? r.boolean(JsonReader::child(v, "rotate")) : true;
+  return {count, radius, seed, centre, rotate};
 }
 
 }  // namespace amalgam::scene_json

@@ -8,9 +8,15 @@
 #include "amalgam/io/json_reader.h"
 #include "amalgam/io/mesh_import.h"
 #include "amalgam/math/transform.h"
+#include "amalgam/scene/instance_patterns.h"
 #include "amalgam/scene/description.h"
 
 namespace amalgam::scene_json {
+
+/// An instance grid, {"nx", "nz", "spacing", "origin"?}: at most 10^8 instances.
+GridPattern read_grid(const JsonReader& r, const JsonValue& v);
+/// An instance scatter, {"count", "radius", "seed"?, "centre"? (or "center"), "rotate"?}.
+ScatterPattern read_scatter(const JsonReader& r, const JsonValue& v);
 
 /// {"colour" (or "color"), "reflectance", "shininess"}, each optional.
 Surface read_surface(const JsonReader& r, const JsonValue& v);

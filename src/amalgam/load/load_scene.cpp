@@ -44,9 +44,15 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
   for (const Texture& t : m.textures) texture_bytes += t.texels.size();
   check_memory(path, MemoryModel::scene(m.triangles.size(), 0, 0) + texture_bytes, config);
   SceneDescription d;
-  d.prims = std::move(m.triangles);
+  if (config.objects) {  // one object, placed once as it is
+    d.meshes.push_back(std::move(m.triangles));
+    d.mesh_uvs.push_back(std::move(m.uvs));
+    d.instances.push_back(Instance{});
+  } else {
+    d.prims = std::move(m.triangles);
+    d.uvs = std::move(m.uvs);
+  }
   d.materials = std::move(m.materials);
-  d.uvs = std::move(m.uvs);
   d.textures = std::move(m.textures);
   d.cameras = std::move(m.cameras);
   d.warnings = std::move(m.dropped);
@@ -73,9 +79,17 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   double bake_seconds = 0.0;
   BuildConfig build;
   build.bake_seconds = &bake_seconds;
+  const std::size_t objects = d.meshes.size();  // the loose primitives come after them
   AnyHierarchy h = build_hierarchy(std::move(d), build);
   const auto t2 = Clock::now();
   LoadedScene s{path, std::move(h), std::move(env)};
+  if (config.objects) {
+    if (config.on_phase) config.on_phase("baking the volumetric amalgams of " + path);
+    const auto* ih = std::get_if<InstancedHierarchy>(&s.hierarchy);
+    if (ih)
+      s.volumes = std::make_shared<const VolumeSet>(bake_volumes(*ih, objects, config.volume));
+    s.volume_seconds = std::chrono::duration<double>(Clock::now() - t2).count();
+  }
   s.cameras = std::move(cameras);
   s.warnings = std::move(warnings);
   s.default_lights = defaults;

@@ -4,12 +4,14 @@
 /// alone, by `load_builtin`.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <variant>
 
 #include "amalgam/builtin/catalog.h"
 #include "amalgam/hierarchy/explicit.h"
 #include "amalgam/hierarchy/instanced.h"
+#include "amalgam/hierarchy/volume/volume_set.h"
 #include "amalgam/scene/description.h"
 
 namespace amalgam {
@@ -26,6 +28,10 @@ struct LoadedScene {
   double load_seconds = 0.0;   ///< reading the scene (or making a builtin's)
   double build_seconds = 0.0;  ///< building the hierarchy, the bake not included
   double bake_seconds = 0.0;   ///< baking the amalgams' appearances
+  /// The volumetric amalgams of the scene's objects (a scene loaded with
+  /// SceneFileConfig::objects: instanced hierarchy, every mesh an instance), else null.
+  std::shared_ptr<const VolumeSet> volumes{};
+  double volume_seconds = 0.0;  ///< baking them
   /// For builtin scenes: the parameters as applied (Params::applied); part of content_hash.
   std::string params{};
   /// The cameras the scene file defines (glTF), env.camera being the chosen one.

@@ -8,7 +8,11 @@
 
 namespace amalgam {
 
-enum class RendererKind : std::uint8_t { kScaleSensitive, kTraditional };
+/// kVolumetric: every object (an instanced mesh) whose cells the ray's cone is wide enough for
+/// is rendered as volumetric amalgams (hierarchy/volume/cells.h), the rest at full detail;
+/// `footprint` is then the cells' size in cone widths. Needs a scene loaded with
+/// SceneFileConfig::objects (io/scene_json.h).
+enum class RendererKind : std::uint8_t { kScaleSensitive, kTraditional, kVolumetric };
 /// The opacity models (traverse/opacity.h): the paper's two, and kPrefiltered, stochastic for
 /// camera rays and deterministic (prefiltered) attenuation for shadow rays.
 /// kComposite: deterministic for every ray, camera rays stopping when their coverage saturates,

@@ -21,6 +21,15 @@ void check_options(const LoadedScene& scene, const RenderOptions& o) {
     throw InputError("--width, --height and --spp must be at least 1");
   if (o.tracer == TracerKind::kEmbree && o.renderer != RendererKind::kTraditional)
     throw InputError("--tracer embree renders at full detail: only --renderer traditional");
+  if (o.renderer == RendererKind::kVolumetric) {
+    if (o.level)
+      throw InputError(
+          "--renderer volumetric chooses its cells by footprint: --level does not apply");
+    if (!scene.volumes || !std::holds_alternative<InstancedHierarchy>(scene.hierarchy))
+      throw InputError("--renderer volumetric: " + scene.name +
+                       " was loaded without volumetric amalgams (load it for the volumetric "
+                       "renderer; builtin scenes have none)");
+  }
 }
 
 namespace {

@@ -7,6 +7,7 @@
 #include "amalgam/render/integrator.h"
 #include "amalgam/render/passes.h"
 #include "amalgam/render/render_isa.h"
+#include "amalgam/render/volume_integrator.h"
 
 namespace amalgam {
 AMALGAM_ISA_BEGIN
@@ -41,6 +42,17 @@ auto dispatch(const LoadedScene& scene, const RenderOptions& o, F&& f) {
       scene.hierarchy);
 }
 
+/// Under the volumetric renderer, calls f(make) with make(counters) -> a VolumeIntegrator and
+/// returns true; else returns false (check_options has made sure the scene has cells).
+template <class F>
+bool with_volumes(const LoadedScene& scene, const Environment& env, const RenderOptions& o, F&& f) {
+  if (o.renderer != RendererKind::kVolumetric) return false;
+  const auto& h = std::get<InstancedHierarchy>(scene.hierarchy);
+  const VolumeSet& v = *scene.volumes;
+  f([&](Counters& c) { return VolumeIntegrator(h, v, env, o.footprint, c); });
+  return true;
+}
+
 }  // namespace
 AMALGAM_ISA_END
 
@@ -50,6 +62,10 @@ bool AMALGAM_ISA_SUFFIXED(render_passes)(const LoadedScene& scene, const Environ
                                          const RenderOptions& o, FilmState& st,
                                          const RenderControl& control) {
   bool interrupted = false;
+  if (with_volumes(scene, env, o, [&](auto make) {
+        interrupted = render_passes(env.camera, o, st, control, make);
+      }))
+    return interrupted;
   dispatch(scene, o, [&](const auto& h, auto lod, auto op, auto order) {
     using I = Integrator<std::decay_t<decltype(h)>, decltype(lod), decltype(op), decltype(order)>;
     interrupted =
@@ -62,6 +78,10 @@ bool AMALGAM_ISA_SUFFIXED(render_tile)(const LoadedScene& scene, const RenderOpt
                                        FilmTile& tile, int s0, int s1,
                                        const std::atomic<bool>* cancel) {
   bool interrupted = false;
+  if (with_volumes(scene, scene.env, o, [&](auto make) {
+        interrupted = render_tile_passes(scene.env.camera, o, tile, s0, s1, cancel, make);
+      }))
+    return interrupted;
   dispatch(scene, o, [&](const auto& h, auto lod, auto op, auto order) {
     using I = Integrator<std::decay_t<decltype(h)>, decltype(lod), decltype(op), decltype(order)>;
     interrupted = render_tile_passes(scene.env.camera, o, tile, s0, s1, cancel,
@@ -72,6 +92,13 @@ bool AMALGAM_ISA_SUFFIXED(render_tile)(const LoadedScene& scene, const RenderOpt
 
 void AMALGAM_ISA_SUFFIXED(trace)(const LoadedScene& scene, const RenderOptions& o, const Ray& ray,
                                  TraceOutput& out) {
+  if (with_volumes(scene, scene.env, o, [&](auto make) {
+        auto integrator = make(out.counters);
+        const SampleResult r = integrator.li(ray, hash_combine(hash_combine(o.seed, 0), 0));
+        out.hit = r.hit;
+        out.colour = r.colour;
+      }))
+    return;
   dispatch(scene, o, [&](const auto& h, auto lod, auto op, auto order) {
     using I = Integrator<std::decay_t<decltype(h)>, decltype(lod), decltype(op), decltype(order)>;
     I integrator(h, scene.env, lod, out.counters);

@@ -16,7 +16,7 @@ struct GenericWalk {
     if (t_entry > s.ray.tmax) return;  // a closer hit was found since this node was tested
     s.counters.count_reached(s.kind);
     if constexpr (State::kMayRender) {
-      if (s.renders(b, level, t_entry)) {
+      if (s.renders(id, b, level, t_entry)) {
         s.render_amalgam(id, level, b, t_entry);
         return;
       }

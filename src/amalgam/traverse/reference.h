@@ -50,7 +50,7 @@ class ReferenceTraversal {
   void enter(NodeId id, int level, const Bbox& b, float t_entry) {
     if (t_entry > s_.ray.tmax) return;  // a closer hit was found since this node was tested
     s_.counters.count_reached(s_.kind);
-    if (s_.renders(b, level, t_entry))
+    if (s_.renders(id, b, level, t_entry))
       s_.render_amalgam(id, level, b, t_entry);
     else
       visit(id, level);

@@ -91,9 +91,15 @@ struct RayState {
   /// The LOD policy's answer for a node on `level` with box `b`, entered at `t`: render it
   /// (true) or descend. A node that contains the ray's origin (the ray starts inside it) is
   /// flagged to the policy as such.
-  bool renders(const Bbox& b, int level, float t) const {
-    return lod.may_render(level) &&
-           lod.render(b, level, ray, t, t <= ray.tmin && b.contains(ray.origin));
+  /// A policy with `render_node` (ObjectLod, traverse/object_lod.h) is also given the node's
+  /// id and the ray's key.
+  bool renders(NodeId id, const Bbox& b, int level, float t) const {
+    if (!lod.may_render(level)) return false;
+    const bool inside = t <= ray.tmin && b.contains(ray.origin);
+    if constexpr (requires { lod.render_node(id, b, level, ray, t, inside, key); })
+      return lod.render_node(id, b, level, ray, t, inside, key);
+    else
+      return lod.render(b, level, ray, t, inside);
   }
 
   /// The fast walks' step on reaching node `id_of()` (level `level`, entered at `t`): when the
@@ -107,7 +113,7 @@ struct RayState {
       if (lod.may_render(level)) {
         const NodeId id = id_of();
         const Bbox b = h.bounds(id);
-        if (renders(b, level, t)) {
+        if (renders(id, b, level, t)) {
           render_amalgam(id, level, b, t);
           return true;
         }
@@ -156,6 +162,15 @@ struct RayState {
   /// The LOD policy renders amalgam `id` (box `b`, entered at `t`): the opacity model decides
   /// what that does to the ray, with the amalgam's opacity in the ray's direction.
   void render_amalgam(NodeId id, int level, const Bbox& b, float t) {
+    if constexpr (requires { Opacity::kDefers; }) {
+      // Deferred (DeferredOpacity): handed to its sink, or recorded for the caller, for camera
+      // and shadow rays alike.
+      if (opacity.sink)
+        opacity.sink->deferred(id, level, t, ray, key, any_hit, done, transmittance);
+      else if (translucent)
+        translucent->push_back({t, id, level, SurfaceHit{}, 0.0f});
+      return;
+    }
     const float a = directional_opacity(h.appearance(id), b, ray.dir);
     switch (opacity.effect(a, key, id, any_hit)) {
       case AmalgamEffect::kPass:

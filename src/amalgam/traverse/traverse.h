@@ -53,13 +53,21 @@ class Traversal {
     return s_.hit;
   }
 
-  /// Fraction of light that passes along `ray` (0: occluded). Counts one shadow ray.
-  float transmittance(const Ray& ray, std::uint64_t key) {
+  /// Fraction of light that passes along `ray` (0: occluded). Counts one shadow ray. Under an
+  /// opacity model that defers amalgams (DeferredOpacity), those the ray meets are appended to
+  /// `*deferred`.
+  float transmittance(const Ray& ray, std::uint64_t key,
+                      std::vector<TranslucentHit>* deferred = nullptr) {
     s_.start(ray, key, RayKind::kShadow, true);
-    s_.translucent = nullptr;
+    s_.translucent = deferred;
     run();
     return s_.transmittance;
   }
+
+  /// The level-of-detail policy, to change between rays (ObjectLod's origin instance).
+  Lod& lod() { return s_.lod; }
+  Opacity& opacity() { return s_.opacity; }
+  Stats& counters() { return s_.counters; }
 
  private:
   static constexpr bool kSorted = Order::kSorted;

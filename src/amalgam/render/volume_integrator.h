@@ -1,0 +1,429 @@
+#pragma once
+/// \file Direct lighting with volumetric amalgams (hierarchy/volume/cells.h) over the
+/// instanced hierarchy (docs/volumetric.md).
+///
+/// A camera sample: the BVH walk (ObjectLod, traverse/object_lod.h) finds the closest
+/// full-detail hit and defers every instance whose cells its cone is wide enough for; each
+/// deferred instance is marched through the cells of its chosen level (traverse/cone_march.h)
+/// as the walk meets it, and the cells met, of every instance, sorted by depth, are composited
+/// front to back: a cell takes its coverage (conditioned on the rest of its object: cells.h) of
+/// what is left, T <- T (1 - coverage), so the cells of one object keep their correlation and
+/// different objects are independent. Once what is left falls below kOpaque the walk is told
+/// to look no deeper. What is left lights the full-detail hit or shows the background.
+///
+/// Shading of a cell: its normal histogram weighted by each bin's projected area toward the
+/// viewer and its response to the light (Lambert plus the Blinn-Phong lobe), at the depth
+/// where its surfaces are seen (the mean depth of a hit in its segment, the cells overlapping
+/// there taken as one homogeneous medium). Shadows: one shadow query per light per camera
+/// sample, from one member of the blend drawn in proportion to its unshadowed share, returning
+/// the transmittance through the full-detail geometry (0 or 1) and the cells of every instance
+/// it crosses (its own too, for an open object; a closed object's self-shadowing is in its
+/// cells' first-hit coverage from the light), each at the level its own cone chooses. Where the
+/// shadow ray still runs within a cell's width of the camera ray that reached its origin (the
+/// hot spot) a cell attenuates it only for the part of its chord beside that ray.
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "amalgam/render/integrator.h"
+#include "amalgam/traverse/object_lod.h"
+
+namespace amalgam {
+AMALGAM_ISA_BEGIN
+
+class VolumeIntegrator final : private DeferSink {
+ public:
+  using IH = InstancedHierarchy;
+  using Trav = Traversal<IH, ObjectLod, DeferredOpacity, SortedOrder, Counters>;
+
+  VolumeIntegrator(const IH& h, const VolumeSet& v, const Environment& env, float cell_pixels,
+                   Counters& counters)
+      : h_(h), v_(v), env_(env), trav_(h, ObjectLod{&h, &v, cell_pixels}, counters) {
+    trav_.opacity().sink = this;
+  }
+  VolumeIntegrator(const VolumeIntegrator& o)
+      : DeferSink(), h_(o.h_), v_(o.v_), env_(o.env_), trav_(o.trav_) {
+    trav_.opacity().sink = this;
+  }
+  VolumeIntegrator& operator=(const VolumeIntegrator&) = delete;
+
+  SampleResult li(const Ray& primary, std::uint64_t key) {
+    ObjectLod& lod = trav_.lod();
+    lod.self = 0, lod.self_full = false, lod.defer_inside = false;
+    objects_.clear();
+    segs_.clear();
+    const TraceHit hit = trav_.intersect(primary, hash_combine(key, 0));
+    const float t_end = hit.kind == TraceHit::Kind::kNone ? kInfinity : hit.t;
+
+    // Composite front to back what lies before the full-detail hit. Each member is shaded
+    // where its surfaces are seen: within its segment, at the mean depth of a hit when the
+    // cells overlapping there (of every object) are taken as one homogeneous medium.
+    members_.clear();
+    float through = 1.0f;  // what is left
+    for (std::size_t k = 0; k < segs_.size() && segs_[k].t0 < t_end; ++k) {
+      Segment& s = segs_[k];
+      s.t1 = std::min(s.t1, t_end);
+      float sigma = 0.0f;  // extinction per unit t of the segments over s.t0
+      for (std::size_t q = k + 1; q-- > 0 && k - q <= 64;) {
+        const Segment& o = segs_[q];
+        if (o.t1 > s.t0 && o.t1 > o.t0)
+          sigma += -std::log(std::max(1.0f - o.alpha, 1e-6f)) / (o.t1 - o.t0);
+      }
+      const float len = s.t1 - s.t0, x = sigma * len;
+      // The mean of an exponential of rate sigma truncated to [0, len].
+      const float depth =
+          x < 1e-3f ? 0.5f * len : len * (1.0f / x - std::exp(-x) / (1.0f - std::exp(-x)));
+      members_.push_back({through * s.alpha, static_cast<int>(k), s.t0 + depth});
+      through *= 1.0f - s.alpha;
+      if (through <= kOpaque) {
+        through = 0.0f;
+        break;
+      }
+    }
+
+    SampleResult r{{}, hit};
+    const Vec3 wo = -primary.dir;
+    Surface end_surface{};
+    const bool end_lit = through > 0.0f && hit.kind == TraceHit::Kind::kPrimitive;
+    if (end_lit) {
+      end_surface = surface_at(h_, hit.id, hit.surf);
+      r.normal += facing(hit.surf.normal, wo) * through;
+      r.albedo += end_surface.colour * through;
+    } else if (through > 0.0f) {
+      r.colour += env_.background * through;
+    }
+    float amalgam_weight = 0.0f;
+    for (const Member& m : members_) {
+      const Segment& s = segs_[static_cast<std::size_t>(m.seg)];
+      const Object& ob = objects_[s.obj];
+      r.albedo += ob.g->surface[s.cell].albedo * m.w;
+      r.normal += cell_normal(ob, s.cell) * m.w;
+      amalgam_weight += m.w;
+    }
+    if (!members_.empty() && amalgam_weight >= through) {
+      const Member& m = members_.front();
+      const Object& ob = objects_[segs_[static_cast<std::size_t>(m.seg)].obj];
+      r.hit = TraceHit{TraceHit::Kind::kAmalgam, m.t, IH::id(ob.slot, 0),
+                       ob.root_level + 1 + ob.level, SurfaceHit{}};
+    }
+    if (members_.empty() && !end_lit) return r;
+
+    // Lights: for each light sample, every member's unshadowed radiance, then one shadow query
+    // from one member drawn in proportion to it.
+    std::uint64_t light_index = 0;
+    std::uint64_t stream = 1;
+    for (const Light& light : env_.lights) {
+      const int samples = light.sized() ? std::max(light.samples, 1) : 1;
+      const std::uint64_t light_key = hash_combine(key, (std::uint64_t{1} << 62) | light_index++);
+      for (int k = 0; k < samples; ++k) {
+        Sampler u(hash_combine(light_key, static_cast<std::uint64_t>(k)));
+        const float u1 = u.next(), u2 = u.next();
+        shade_light(primary, hit, end_surface, end_lit, through, light, samples, u1, u2,
+                    hash_combine(key, stream++), r.colour);
+      }
+    }
+    return r;
+  }
+
+ private:
+  /// Below this transmittance a ray ends: nothing behind can show.
+  static constexpr float kOpaque = 1e-4f;
+
+  struct Object {
+    std::uint64_t slot;  ///< instance index + 1
+    const CellGrid* g;
+    int level;       ///< the cell level chosen for this ray
+    int root_level;  ///< the instance root's level in the hierarchy
+    Ray ray;         ///< the ray in object space (direction unnormalised: the same t)
+    Vec3 dir;        ///< the ray's unit direction in object space
+  };
+  struct Segment {
+    float t0, t1;
+    std::uint32_t cell;
+    std::uint32_t obj;
+    float alpha;
+  };
+  struct Member {
+    float w;
+    int seg;
+    float t;  ///< where along the camera ray its surfaces are seen
+  };
+  /// A member of the blend lit by one light sample.
+  struct Lit {
+    Vec3 u;     ///< unshadowed radiance
+    Vec3 from;  ///< its shadow ray's origin
+    LightSample ls;
+    float w;  ///< its weight in the blend
+    int seg;  ///< its segment, or -1: the full-detail hit
+  };
+  /// What the shadow query in flight needs in deferred(): the instance it leaves and how, and
+  /// the direction back to the viewer along the camera ray that reached its origin.
+  struct ShadowQuery {
+    std::uint64_t self = 0;
+    bool self_full = false;
+    float sin_apart = 1.0f;  ///< sine of the angle between the shadow ray and `to_viewer`
+  };
+
+  Object object_of(NodeId root, int root_level, float t, const Ray& ray, std::uint64_t key) {
+    Object ob;
+    ob.slot = IH::slot(root);
+    const IH::InstanceData& in = h_.instances[ob.slot - 1];
+    ob.g = v_.grid(in.mesh);
+    ob.level = std::min(trav_.lod().level_for(*ob.g, ob.slot, ray, t, key), ob.g->levels - 1);
+    ob.root_level = root_level;
+    ob.ray = in.identity ? ray : IH::object_ray(in, ray);
+    ob.dir = normalize(ob.ray.dir);
+    return ob;
+  }
+
+  /// The walk met instance `root` (DeferSink): a camera ray marches it, adds its cells to the
+  /// blend and lowers the walk's tmax to where the blend saturates; a shadow ray multiplies its
+  /// transmittance by the instance's and ends once nothing passes.
+  void deferred(NodeId root, int level, float t, Ray& ray, std::uint64_t key, bool shadow,
+                bool& done, float& transmittance) override {
+    Object ob = object_of(root, level, t, ray, key);
+    float t0 = ray.tmin, t1 = ray.tmax;
+    if (!clip_to_grid(*ob.g, ob.ray.origin, ob.ray.dir, t0, t1)) return;
+    Counters& counters = trav_.counters();
+    if (shadow) {
+      if (ob.slot == query_.self && ob.g->oriented) return;  // in its cells' shading
+      transmittance *= shadow_march(ob, ray, t0, t1, counters, level);
+      if (!(transmittance > kOpaque)) transmittance = 0.0f, done = true;
+      return;
+    }
+    const auto index = static_cast<std::uint32_t>(objects_.size());
+    objects_.push_back(ob);
+    const OctahedralLerp lerp = ob.g->lerp(ob.dir);
+    const std::size_t first = segs_.size();
+    float left = 1.0f;  // this object's own transmittance so far
+    const int steps = march_cells(*ob.g, ob.level, ob.ray.origin, ob.ray.dir, t0, t1,
+                                  [&](std::uint32_t cell, float a, float b) {
+                                    const float alpha = ob.g->coverage_of(cell, lerp);
+                                    if (alpha > 0.0f) segs_.push_back({a, b, cell, index, alpha});
+                                    left *= 1.0f - alpha;
+                                    return left > kOpaque;
+                                  });
+    counters.count_tests(RayKind::kPrimary, ObjectKind::kCell, level + 1 + ob.level,
+                         static_cast<std::uint64_t>(steps));
+    // Merge the new cells (in depth order already) into the sorted blend, then find where it
+    // saturates: nothing beyond can show, whatever the walk still finds.
+    const auto by_depth = [](const Segment& a, const Segment& b) {
+      return a.t0 < b.t0 ||
+             (a.t0 == b.t0 && (a.obj < b.obj || (a.obj == b.obj && a.cell < b.cell)));
+    };
+    std::inplace_merge(segs_.begin(), segs_.begin() + static_cast<std::ptrdiff_t>(first),
+                       segs_.end(), by_depth);
+    float through = 1.0f;
+    for (const Segment& s : segs_) {
+      through *= 1.0f - s.alpha;
+      if (through <= kOpaque) {
+        ray.tmax = std::min(ray.tmax, s.t0);
+        break;
+      }
+    }
+  }
+
+  /// The transmittance of object `ob` along shadow ray `ray` over [t0, t1] (clipped to its
+  /// grid): the product of 1 - coverage (seen from the light) over its cells crossed. A cell
+  /// that holds the ray's origin attenuates it by the share of the cell's mean chord still
+  /// ahead (as a homogeneous cell would); where the ray is still within a cell's width of the
+  /// camera ray that reached its origin, only the share of the chord beside that ray counts.
+  float shadow_march(const Object& ob, const Ray& ray, float t0, float t1, Counters& counters,
+                     int root_level) {
+    const bool starts_inside = t0 == ray.tmin;
+    const OctahedralLerp lerp = ob.g->lerp(-ob.dir);
+    const Vec3 cs = ob.g->cell_size(ob.level);
+    const float chord = cs.x * cs.y * cs.z / ob.g->projected_area(ob.level, ob.dir);
+    const float width = std::cbrt(cs.x * cs.y * cs.z) * v_.instance_scale[ob.slot - 1];
+    const float apart_per_t = query_.sin_apart * length(ray.dir) / width;
+    float tr = 1.0f;
+    const int steps = march_cells(
+        *ob.g, ob.level, ob.ray.origin, ob.ray.dir, t0, t1,
+        [&](std::uint32_t cell, float a, float b) {
+          const float pass = 1.0f - ob.g->coverage_of(cell, lerp);
+          const float beside = std::min(1.0f, 0.5f * (a + b) * apart_per_t);
+          const float share = starts_inside && a == t0 ? std::min(1.0f, (b - a) / chord) : 1.0f;
+          tr *= std::pow(pass, beside * share);
+          return tr > kOpaque;
+        });
+    counters.count_tests(RayKind::kShadow, ObjectKind::kCell, root_level + 1 + ob.level,
+                         static_cast<std::uint64_t>(steps));
+    return tr;
+  }
+
+  static Vec3 facing(Vec3 n, Vec3 wo) { return dot(n, wo) < 0 ? -n : n; }
+
+  /// A direction of world space in the object space of instance `slot`, normalised.
+  Vec3 to_object(std::uint64_t slot, Vec3 w) const {
+    const IH::InstanceData& in = h_.instances[slot - 1];
+    return in.identity ? w : normalize(in.to_object.vector(w));
+  }
+
+  /// The cell's mean normal as seen (for the normal output), in world space.
+  Vec3 cell_normal(const Object& ob, std::uint32_t cell) const {
+    const CellGrid& g = *ob.g;
+    const int nb = g.normal_bins();
+    const std::uint16_t* hist = g.normals.data() + static_cast<std::size_t>(cell) * nb;
+    const Vec3 o = -ob.dir;
+    Vec3 sum{};
+    for (int k = 0; k < nb; ++k) {
+      const Vec3 m = g.normal_dirs[static_cast<std::size_t>(k)];
+      const float c = dot(m, o);
+      if (g.oriented ? c > 0.0f : c != 0.0f) sum += (c < 0 ? -m : m) * (hist[k] * std::fabs(c));
+    }
+    const IH::InstanceData& in = h_.instances[ob.slot - 1];
+    if (!in.identity)
+      sum = Vec3{dot(in.normal_rows[0], sum), dot(in.normal_rows[1], sum),
+                 dot(in.normal_rows[2], sum)};
+    const float len = length(sum);
+    return len > 0.0f ? sum / len : Vec3{};
+  }
+
+  /// Radiance toward the viewer per unit of the cell's weight, lit from world direction `wi`
+  /// with irradiance `e`, without shadows (for a closed object, with its own).
+  Vec3 cell_radiance(const Object& ob, std::uint32_t cell, Vec3 wi, Vec3 e) const {
+    constexpr float inv_pi = std::numbers::inv_pi_v<float>;
+    const CellGrid& g = *ob.g;
+    const CellSurface& s = g.surface[cell];
+    const Vec3 o = -ob.dir, l = to_object(ob.slot, wi);
+    const int nb = g.normal_bins();
+    const std::uint16_t* hist = g.normals.data() + static_cast<std::size_t>(cell) * nb;
+    const bool spec = s.reflectance > 0.0f;
+    const Vec3 half = spec ? normalize(o + l) : Vec3{};
+    float seen = 0.0f, diffuse = 0.0f, specular = 0.0f, facing_light = 0.0f;
+    for (int k = 0; k < nb; ++k) {
+      if (!hist[k]) continue;
+      const float hk = static_cast<float>(hist[k]);
+      Vec3 m = g.normal_dirs[static_cast<std::size_t>(k)];
+      const float co = dot(m, o), cl = dot(m, l);
+      float w, lit;
+      if (g.oriented) {
+        w = std::max(co, 0.0f);
+        lit = std::max(cl, 0.0f);
+        facing_light += hk * lit;
+      } else {
+        w = std::fabs(co);
+        if (co < 0.0f) m = -m;
+        lit = std::max(co < 0.0f ? -cl : cl, 0.0f);
+      }
+      seen += hk * w;
+      diffuse += hk * w * lit;
+      if (spec && lit > 0.0f)
+        specular += hk * w * lit * std::pow(std::max(0.0f, dot(m, half)), g.shininess);
+    }
+    if (!(seen > 0.0f)) return {};
+    Vec3 f = s.albedo * (inv_pi * diffuse / seen);
+    if (spec) {
+      const float lobe = s.reflectance * (g.shininess + 8.0f) * (inv_pi / 8.0f) * (specular / seen);
+      f += Vec3{lobe, lobe, lobe};
+    }
+    if (g.oriented) {
+      // A closed object shadows itself as a solid: its surfaces in the cell facing the light
+      // are lit where they are the first surfaces the light meets, i.e. the share of their
+      // unoccluded projected area toward the light that the cell's first-hit coverage seen
+      // from the light holds (all of it on a convex object).
+      if (!(facing_light > 0.0f)) return {};
+      const float reached = g.first_hit_of(cell, g.lerp(-l)) * g.projected_area(ob.level, l);
+      f = f * std::min(1.0f, reached / (s.area * facing_light * (1.0f / 65535.0f)));
+    }
+    return f * e;
+  }
+
+  /// The light sample (u1, u2) of `light` seen from `p`; false if it brings nothing.
+  static bool light_sample(const Light& light, Vec3 p, int samples, float u1, float u2,
+                           LightSample& ls) {
+    if (light.sized()) return sample_sized_light(light, p, u1, u2, samples, ls);
+    if (light.kind == LightKind::kPoint) {
+      const Vec3 d = light.position - p;
+      ls.dist = length(d);
+      if (!(ls.dist > 0.0f)) return false;
+      ls.wi = d / ls.dist;
+      ls.e = light.intensity / (ls.dist * ls.dist);
+      return true;
+    }
+    ls.wi = -normalize(light.direction);
+    ls.dist = kInfinity;
+    ls.e = light.intensity;
+    return true;
+  }
+
+  /// One light sample: each member's unshadowed radiance, one shadow query from a member drawn
+  /// by its share; adds the estimate to `colour`.
+  void shade_light(const Ray& primary, const TraceHit& hit, const Surface& end_surface,
+                   bool end_lit, float end_w, const Light& light, int samples, float u1, float u2,
+                   std::uint64_t key, Vec3& colour) {
+    lits_.clear();
+    const Vec3 wo = -primary.dir;
+    for (const Member& m : members_) {
+      const Segment& s = segs_[static_cast<std::size_t>(m.seg)];
+      const Vec3 p = primary.at(m.t);
+      LightSample ls;
+      if (!light_sample(light, p, samples, u1, u2, ls)) continue;
+      const Vec3 u = cell_radiance(objects_[s.obj], s.cell, ls.wi, ls.e);
+      if (luminance(u) > 0.0f) lits_.push_back({u, p, ls, m.w, m.seg});
+    }
+    if (end_lit) {
+      const SurfaceHit& sh = hit.surf;
+      const Vec3 origin = offset_ray_origin(sh.p, sh.p_error, sh.normal);
+      LightSample ls;
+      if (light_sample(light, origin, samples, u1, u2, ls)) {
+        const Vec3 n = facing(sh.normal, wo);
+        const float f_cos = dot(n, ls.wi);
+        if (f_cos > 0.0f && dot(sh.normal, ls.wi) > 0.0f) {
+          const Vec3 u = brdf(end_surface, n, ls.wi, wo) * ls.e * f_cos;
+          if (luminance(u) > 0.0f) lits_.push_back({u, origin, ls, end_w, -1});
+        }
+      }
+    }
+    float total = 0.0f;
+    for (const Lit& l : lits_) total += l.w * luminance(l.u);
+    if (!(total > 0.0f)) return;
+    float x = to_unit_float(hash_combine(key, 0x766f6c)) * total;
+    std::size_t j = 0;
+    while (j + 1 < lits_.size() && x >= lits_[j].w * luminance(lits_[j].u))
+      x -= lits_[j].w * luminance(lits_[j].u), ++j;
+    const Lit& c = lits_[j];
+    const float p = c.w * luminance(c.u) / total;
+    if (!(p > 0.0f)) return;
+    Ray shadow = Ray::make(c.from, c.ls.wi, 0.0f, c.ls.dist * (1.0f - 2.0f * gamma(3)));
+    const bool from_cell = c.seg >= 0;
+    const float t_from = from_cell ? members_t(c.seg) : hit.t;
+    shadow.cone_width = primary.footprint(t_from);
+    if (light.kind == LightKind::kPoint)
+      shadow.cone_spread = (c.ls.end_width - shadow.cone_width) / std::max(c.ls.dist, 1e-30f);
+    else
+      shadow.cone_spread = c.ls.spread;
+    query_.self =
+        from_cell ? objects_[segs_[static_cast<std::size_t>(c.seg)].obj].slot : IH::slot(hit.id);
+    query_.self_full = !from_cell;
+    const float cos_apart = std::clamp(dot(wo, c.ls.wi), -1.0f, 1.0f);
+    query_.sin_apart = std::sqrt(std::max(0.0f, 1.0f - cos_apart * cos_apart));
+    ObjectLod& lod = trav_.lod();
+    lod.self = query_.self, lod.self_full = query_.self_full, lod.defer_inside = true;
+    const float tr = trav_.transmittance(shadow, key);
+    lod.self = 0, lod.self_full = false, lod.defer_inside = false;
+    if (tr > 0.0f) colour += c.u * (c.w * tr / p);
+  }
+
+  /// The depth along the camera ray where the member of segment `seg` is seen.
+  float members_t(int seg) const {
+    for (const Member& m : members_)
+      if (m.seg == seg) return m.t;
+    return segs_[static_cast<std::size_t>(seg)].t0;
+  }
+
+  const IH& h_;
+  const VolumeSet& v_;
+  const Environment& env_;
+  Trav trav_;
+  ShadowQuery query_;
+  std::vector<Object> objects_;
+  std::vector<Segment> segs_;
+  std::vector<Member> members_;
+  std::vector<Lit> lits_;
+};
+
+AMALGAM_ISA_END
+}  // namespace amalgam
