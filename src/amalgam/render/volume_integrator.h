@@ -19,8 +19,8 @@
 /// the transmittance through the full-detail geometry (0 or 1) and the cells of every instance
 /// it crosses (its own too, for an open object; a closed object's self-shadowing is in its
 /// cells' first-hit coverage from the light), each at the level its own cone chooses. Where the
-/// shadow ray still runs within a cell's width of the camera ray that reached its origin (the
-/// hot spot) a cell attenuates it only for the part of its chord beside that ray.
+/// shadow ray's cone still overlaps the camera cone that reached its origin (the hot spot) a
+/// cell attenuates it only for the part of its chord beside that cone.
 
 #include <algorithm>
 #include <cmath>
@@ -228,15 +228,16 @@ class VolumeIntegrator final : private DeferSink {
   /// The transmittance of object `ob` along shadow ray `ray` over [t0, t1] (clipped to its
   /// grid): the product of 1 - coverage (seen from the light) over its cells crossed. A cell
   /// that holds the ray's origin attenuates it by the share of the cell's mean chord still
-  /// ahead (as a homogeneous cell would); where the ray is still within a cell's width of the
-  /// camera ray that reached its origin, only the share of the chord beside that ray counts.
+  /// ahead (as a homogeneous cell would); where the shadow ray's cone still overlaps the camera
+  /// cone that reached its origin (both one cone width wide there: the hot spot), only the
+  /// share of the chord beside that cone counts.
   float shadow_march(const Object& ob, const Ray& ray, float t0, float t1, Counters& counters,
                      int root_level) {
     const bool starts_inside = t0 == ray.tmin;
     const OctahedralLerp lerp = ob.g->lerp(-ob.dir);
     const Vec3 cs = ob.g->cell_size(ob.level);
     const float chord = cs.x * cs.y * cs.z / ob.g->projected_area(ob.level, ob.dir);
-    const float width = std::cbrt(cs.x * cs.y * cs.z) * v_.instance_scale[ob.slot - 1];
+    const float width = std::max(ray.cone_width, 1e-30f);
     const float apart_per_t = query_.sin_apart * length(ray.dir) / width;
     float tr = 1.0f;
     const int steps = march_cells(

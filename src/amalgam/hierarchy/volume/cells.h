@@ -46,6 +46,11 @@ struct VolumeConfig {
   /// face-on).
   int lines = 4;
   std::uint64_t seed = 0x766f6c;
+  /// false: the coverage is that of the cell's surfaces alone, as if nothing around them in
+  /// the mesh correlated with them: 1 - exp(-tau), tau their projected area over the cell's
+  /// (the independent, exponential model of a medium). Only to measure what the fit to the
+  /// mesh's first hits buys (docs/volumetric.md); the first-hit coverage is kept either way.
+  bool correlated = true;
   bool parallel = true;  ///< oneTBB over the direction bins (the result does not depend on it)
 };
 
