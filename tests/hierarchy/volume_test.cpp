@@ -5,11 +5,11 @@
 #include <cmath>
 #include <vector>
 
-#include "amalgam/geometry/intersect.h"
 #include "amalgam/hierarchy/build/build.h"
 #include "amalgam/hierarchy/volume/cells.h"
 #include "amalgam/math/random.h"
 #include "amalgam/traverse/cone_march.h"
+#include "amalgam/traverse/traverse.h"
 
 namespace amalgam {
 namespace {
@@ -65,7 +65,7 @@ struct ColumnSums {
   std::vector<double> occluded, sum;  ///< per level
   double hit = 0;
 };
-ColumnSums column_sums(const CellGrid& g, const std::vector<Primitive>& prims, Vec3 d, int lines) {
+ColumnSums column_sums(const CellGrid& g, const ExplicitHierarchy& h, Vec3 d, int lines) {
   ColumnSums out;
   out.sum.assign(static_cast<std::size_t>(g.levels), 0.0);
   out.occluded.assign(static_cast<std::size_t>(g.levels), 0.0);
@@ -75,17 +75,14 @@ ColumnSums column_sums(const CellGrid& g, const std::vector<Primitive>& prims, V
   const float radius = 0.5f * length(g.size);
   Sampler s(77);
   const OctahedralLerp lerp = g.lerp(d);
+  Counters counters;
+  Traversal<ExplicitHierarchy, TraditionalLod, StochasticOpacity, SortedOrder> trav(h, {},
+                                                                                    counters);
   for (int i = 0; i < lines; ++i) {
     const float x = (2 * s.next() - 1) * radius, y = (2 * s.next() - 1) * radius;
     const Vec3 o = centre + u * x + v * y - d * (2 * radius);
     const Ray ray = Ray::make(o, d);
-    bool hit = false;
-    for (const Primitive& p : prims)
-      if (intersect(p, ray)) {
-        hit = true;
-        break;
-      }
-    out.hit += hit;
+    out.hit += trav.intersect(ray, static_cast<std::uint64_t>(i)).kind != TraceHit::Kind::kNone;
     for (int L = 0; L < g.levels; ++L) {
       float t0 = 0, t1 = kInfinity;
       if (!clip_to_grid(g, o, d, t0, t1)) continue;
@@ -113,7 +110,7 @@ void expect_sums_match(const std::vector<Primitive>& prims, const char* what) {
   ASSERT_GT(g.cells(), 0u);
   for (Vec3 d : {normalize(Vec3{0.3f, -0.8f, 0.5f}), normalize(Vec3{1, 0.02f, 0.01f}),
                  octahedral_bin_dir(27, g.dir_res), normalize(Vec3{0, -0.573f, -0.819f})}) {
-    const ColumnSums c = column_sums(g, prims, d, 20000);
+    const ColumnSums c = column_sums(g, h, d, 20000);
     for (int L = 0; L < g.levels; ++L) {
       SCOPED_TRACE(std::string(what) + " level " + std::to_string(L) + " d = " +
                    std::to_string(d.x) + "," + std::to_string(d.y) + "," + std::to_string(d.z));
