@@ -209,3 +209,20 @@ def test_light_samples_as_cli(cli, tmp_path):
     assert r.stats["rays"]["shadow"] < four.stats["rays"]["shadow"]
     with pytest.raises(ValueError, match="--light-samples"):
         s.render(width=4, height=4, spp=1, light_samples=0)
+
+
+def test_volumetric_same_bits_as_cli(cli, tmp_path):
+    """renderer='volumetric' on a scene loaded with volumetric=True: the CLI's bytes and counts."""
+    scene = str(pathlib.Path(__file__).resolve().parents[2] / "scenes" / "volumetric" / "tree.json")
+    out, stats = tmp_path / "v.pfm", tmp_path / "v.json"
+    subprocess.run(
+        [cli, "render", scene, "--renderer", "volumetric", "--width", "32", "--height", "24",
+         "--spp", "2", "--seed", "3", "--out", str(out), "--stats", str(stats)],
+        check=True, capture_output=True)
+    r = amalgam.load(scene, volumetric=True).render(
+        width=32, height=24, spp=2, seed=3, renderer="volumetric")
+    assert np.array_equal(r.image.view(np.uint32), read_pfm(out).view(np.uint32))
+    cli_stats = json.loads(stats.read_text())
+    assert r.stats["tests"] == cli_stats["tests"]
+    assert r.stats["tests"]["cell"] > 0
+    assert r.stats["volumes"]["cells"] == cli_stats["volumes"]["cells"] > 0
