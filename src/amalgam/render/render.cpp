@@ -25,6 +25,9 @@ void check_options(const LoadedScene& scene, const RenderOptions& o) {
     if (o.level)
       throw InputError(
           "--renderer volumetric chooses its cells by footprint: --level does not apply");
+    if (o.opacity != OpacityKind::kStochastic)
+      throw InputError(
+          "--renderer volumetric composites its cells by coverage: --opacity does not apply");
     if (!scene.volumes || !std::holds_alternative<InstancedHierarchy>(scene.hierarchy))
       throw InputError("--renderer volumetric: " + scene.name +
                        " was loaded without volumetric amalgams (load it for the volumetric "
