@@ -78,6 +78,17 @@ def run(cmd):
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
 
 
+_HASHES = {}
+
+
+def binary_hash(path):
+    """The executable's content hash: a rebuilt renderer never reads another's cached images."""
+    if path not in _HASHES:
+        with open(path, "rb") as f:
+            _HASHES[path] = hashlib.sha1(f.read()).hexdigest()
+    return _HASHES[path]
+
+
 class Cache:
     """Renders keyed by their command line (references take the longest)."""
 
@@ -86,7 +97,7 @@ class Cache:
         os.makedirs(folder, exist_ok=True)
 
     def render(self, amalgam, args, with_stats=False):
-        key = hashlib.sha1(" ".join([amalgam] + args).encode()).hexdigest()[:16]
+        key = hashlib.sha1(" ".join([binary_hash(amalgam)] + args).encode()).hexdigest()[:16]
         img = os.path.join(self.folder, key + ".pfm")
         stats = os.path.join(self.folder, key + ".json")
         cost = os.path.join(self.folder, key + "-cost.pfm")
@@ -153,6 +164,10 @@ def evaluate(a, name, cache):
         os.unlink(empty_scene)
     contribution = np.abs(lum(ref) - lum(empty))
     obj = contribution > 1e-3
+    near = obj.copy()  # the object's pixels and two around them: where it can change anything
+    for _ in range(2):
+        p = np.pad(near, 1)
+        near = p[1:-1, 1:-1] | p[:-2, 1:-1] | p[2:, 1:-1] | p[1:-1, :-2] | p[1:-1, 2:]
     rng = np.random.default_rng(1)
     k = a.footprint
     blurred = lod_bound.disc_blur(hi, k * f)
@@ -161,7 +176,9 @@ def evaluate(a, name, cache):
     ideal_spp = lod_bound.rmse_at(blurred.reshape(h, f, w, f, 3), ref, a.spp, f, 8, rng)
     result = {"view": name, "width": w, "height": h, "object_pixels": int(obj.sum()),
               "ideal_rmse_1spp": ideal_1spp, "ideal_rmse": ideal_spp,
-              "ref_cone_rmse": float(np.sqrt(np.mean((ref_cone - ref) ** 2))), "renderers": {}}
+              "ref_cone_rmse": float(np.sqrt(np.mean((ref_cone - ref) ** 2))),
+              "hf_ideal": hf_energy(lum(ref_cone)) / hf_energy(lum(ref)), "renderers": {}}
+    images = {}
     renderers = {"volumetric": ["--renderer", "volumetric", "--footprint", str(k)] + a.extra,
                  "traditional": ["--renderer", "traditional"]}
     for rname, ropts in renderers.items():
@@ -189,8 +206,10 @@ def evaluate(a, name, cache):
                 "tile_worst": float(tile_rel.flat[np.argmax(np.abs(tile_rel))]),
                 "tiles": [round(float(x), 4) for x in tile_rel.flat],
                 "frame": float(lm.mean() / lr.mean() - 1),
-                "object": float((lm - lr).sum() / contribution.sum()),
-                "object_l1": float(np.abs(lm - lr).sum() / contribution.sum()),
+                "object": float((lm - lr)[near].sum() / contribution.sum()),
+                "object_se": float(np.std([(lum(i) - lr)[near].sum() for i in imgs], ddof=1)
+                                   / np.sqrt(len(imgs)) / contribution.sum()),
+                "object_l1": float(np.abs(lm - lr)[near].sum() / contribution.sum()),
                 "hf": hf,
                 "tests_object": float(cost[obj].mean()) if obj.any() else None,
                 "tests_frame": float(cost.mean()),
@@ -200,8 +219,25 @@ def evaluate(a, name, cache):
             }
             if spp == 1:
                 row[spp]["achieved_over_ideal"] = rmse / ideal_1spp if ideal_1spp > 0 else None
+            else:
+                images[rname] = (runs[0]["image"], cost)
         result["renderers"][rname] = row
-    return result
+    images["reference"] = ref
+    images["box"] = crop_box(near, w, h)
+    return result, images
+
+
+def crop_box(mask, w, h):
+    """Rows and columns around `mask`, padded, at least a quarter of the frame, 4:3."""
+    ys, xs = np.nonzero(mask)
+    if len(ys) == 0 or mask.mean() > 0.25:
+        return 0, h, 0, w
+    cy, cx = (ys.min() + ys.max() + 1) / 2, (xs.min() + xs.max() + 1) / 2
+    half_w = max((xs.max() - xs.min() + 1) * 0.75, (ys.max() - ys.min() + 1) * 0.75 * 4 / 3, w / 8)
+    half_h = half_w * 3 / 4
+    x0 = int(np.clip(round(cx - half_w), 0, w - 2 * half_w))
+    y0 = int(np.clip(round(cy - half_h), 0, h - 2 * half_h))
+    return y0, y0 + int(round(2 * half_h)), x0, x0 + int(round(2 * half_w))
 
 
 def main():
@@ -215,16 +251,19 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--cache", default=os.path.join(ROOT, "out", "volumetric-eval"))
     ap.add_argument("--json")
+    ap.add_argument("--doc", help="write DIR/results.md, results.json and views.png (docs/volumetric)")
     ap.add_argument("extra", nargs="*", help="more options for the volumetric renderer")
     a = ap.parse_args()
     cache = Cache(a.cache)
     results = []
+    figures = {}
     print("| view | obj px | renderer | spp | RMSE | bias | bias vs cone ref | sd | worst tile | "
           "frame | object | HF | tests/ray (object) | ns/sample | achieved/ideal |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name in a.views.split(","):
-        r = evaluate(a, name, cache)
+        r, images = evaluate(a, name, cache)
         results.append(r)
+        figures[name] = images
         for rname, row in r["renderers"].items():
             for spp, m in row.items():
                 ai = m.get("achieved_over_ideal")
@@ -237,6 +276,119 @@ def main():
     if a.json:
         with open(a.json, "w") as f:
             json.dump(results, f, indent=1)
+    if a.doc:
+        write_doc(a, results, figures)
+
+
+def machine():
+    cpu = "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            cpu = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
+                            capture_output=True, text=True).stdout.strip()
+    return f"{cpu}, {os.cpu_count()} cores, {time.strftime('%Y-%m-%d')}, commit {commit}"
+
+
+def verdict(ok):
+    return "met" if ok else "**not met**"
+
+
+def write_doc(a, results, figures):
+    """docs/volumetric/results.md: the table and the targets' verdicts, computed here."""
+    os.makedirs(a.doc, exist_ok=True)
+    with open(os.path.join(a.doc, "results.json"), "w") as f:
+        json.dump(results, f, indent=1)
+    argv = " ".join(["/usr/bin/python3", "scripts/volumetric_eval.py"] +
+                    [x if not x.startswith(ROOT) else os.path.relpath(x, ROOT) for x in sys.argv[1:]])
+    L = ["<!-- written by scripts/volumetric_eval.py; do not edit -->",
+         f"Measured by `{argv}` on {machine()}.",
+         "",
+         f"Stratified sampling, {a.spp} spp and 1 spp, seeds 1-3; reference: full detail at "
+         f"{a.factor} x {a.factor} sub-pixels, {a.ref_spp} spp each; volumetric cell size "
+         f"{a.footprint:g} cone width(s). Tiles: 32 x 32, mean luminance over the seeds. "
+         "`object`: the error of the object's contribution (its pixels and its shadow, two pixels "
+         "around), ± its standard error over the seeds. HF: high-frequency "
+         "energy over the reference's (the ideal prefilter's own in brackets). Tests per camera "
+         "ray over the object's pixels, shadow rays included.",
+         "",
+         "| view | object px | renderer | worst tile | frame | object | HF (ideal) | 1 spp RMSE / ideal | tests per ray (object) | ns per sample | bake s |",
+         "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    checks = {"tiles": [], "frame": [], "hf": [], "ideal": [], "tests": []}
+    for r in results:
+        v = r["renderers"]["volumetric"][a.spp]
+        t = r["renderers"]["traditional"][a.spp]
+        one_v = r["renderers"]["volumetric"][1]
+        for name, m, one in (("volumetric", v, one_v),
+                             ("traditional", t, r["renderers"]["traditional"][1])):
+            ai = one.get("achieved_over_ideal")
+            bake = m.get("bake_s")
+            to = m["tests_object"]
+            L.append(f"| {r['view']} | {r['object_pixels']} | {name} | {100 * m['tile_worst']:+.2f} % | "
+                     f"{100 * m['frame']:+.2f} % | {100 * m['object']:+.1f} ± {100 * m['object_se']:.1f} % | "
+                     f"{m['hf']:.2f} ({r['hf_ideal']:.2f}) | {'' if ai is None else f'{ai:.2f}'} | "
+                     f"{'' if to is None else f'{to:.1f}'} | {m['ns_per_sample']:.0f} | "
+                     f"{'' if bake is None else f'{bake:.2f}'} |")
+        checks["tiles"].append((r["view"], abs(v["tile_worst"]) <= 0.03))
+        checks["frame"].append((r["view"], abs(v["frame"]) <= 0.01))
+        checks["hf"].append((r["view"], v["hf"] >= 0.8))
+        if one_v.get("achieved_over_ideal") is not None:
+            checks["ideal"].append((r["view"], one_v["achieved_over_ideal"] <= 1.5))
+        if r["view"].startswith(("tuft", "tree")) and v["tests_object"] and t["tests_object"]:
+            checks["tests"].append((r["view"], v["tests_object"] <= t["tests_object"] / 5))
+    names = {"tiles": "every 32 x 32 tile within 3 %", "frame": "frame within 1 %",
+             "hf": "high-frequency energy >= 0.8 of the reference's",
+             "ideal": "1-spp error within 1.5x of the ideal bound's",
+             "tests": "tests per camera ray <= 1/5 of full detail's (tuft and tree views)"}
+    L += ["", "| target | verdict | views that miss it |", "|---|---|---|"]
+    for k, rows in checks.items():
+        miss = [v for v, ok in rows if not ok]
+        L.append(f"| {names[k]} | {verdict(not miss)} | {', '.join(miss)} |")
+    meadow = [r for r in results if r["view"] == "bias-meadow"]
+    if meadow:
+        w = meadow[0]["renderers"]["volumetric"][a.spp]["tile_worst"]
+        L.append(f"| stop gate: bias-meadow's worst tile within 1.5 % (half the tile target) | "
+                 f"{verdict(abs(w) <= 0.015)} | {100 * w:+.2f} % |")
+    with open(os.path.join(a.doc, "results.md"), "w") as f:
+        f.write("\n".join(L) + "\n")
+    write_figure(results, figures, os.path.join(a.doc, "views.png"))
+
+
+def write_figure(results, figures, out):
+    """Per view (cropped around the object): the reference, one volumetric and one full-detail
+    render at the same spp, and the tests per pixel of both on one log scale."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import LogNorm
+    names = [r["view"] for r in results]
+    fig, axes = plt.subplots(len(names), 5, figsize=(13, 2.2 * len(names)), squeeze=False,
+                             layout="constrained")
+    cols = ["reference", "volumetric", "full detail", "tests, volumetric", "tests, full detail"]
+    for i, name in enumerate(names):
+        im = figures[name]
+        vmax = max(float(im["volumetric"][1].max()), float(im["traditional"][1].max()), 1.0)
+        y0, y1, x0, x1 = im["box"]
+        panels = [p[y0:y1, x0:x1] for p in (im["reference"], im["volumetric"][0], im["traditional"][0],
+                                            im["volumetric"][1], im["traditional"][1])]
+        for j, p in enumerate(panels):
+            ax = axes[i][j]
+            if j < 3:
+                ax.imshow(np.clip(p, 0, 1) ** (1 / 2.2))
+            else:
+                last = ax.imshow(np.maximum(p, 1.0), norm=LogNorm(1.0, vmax), cmap="magma")
+            ax.set_xticks([]), ax.set_yticks([])
+            if i == 0:
+                ax.set_title(cols[j])
+            if j == 0:
+                ax.set_ylabel(name if (y1 - y0, x1 - x0) == im["reference"].shape[:2] else
+                              f"{name}\n(crop {x1 - x0} x {y1 - y0})")
+        fig.colorbar(last, ax=axes[i][3:].tolist(), shrink=0.8, label="tests per camera sample")
+    tmp = out + ".tmp.png"
+    fig.savefig(tmp, dpi=80)
+    os.replace(tmp, out)
 
 
 if __name__ == "__main__":
