@@ -134,8 +134,8 @@ RenderOptions options(const RenderOptions& base, int spp, RendererKind kind, flo
                       std::uint64_t seed = 0) {
   RenderOptions o = base;
   o.spp = spp;
-  o.renderer = kind;
-  o.footprint = footprint;
+  o.lod = kind == RendererKind::kTraditional ? LevelOfDetail{FullDetail{}}
+                                             : LevelOfDetail{ByFootprint{footprint}};
   o.seed = seed;
   return o;
 }

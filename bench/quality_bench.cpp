@@ -140,7 +140,7 @@ Reference reference(const Args& a) {
   const int batches = std::max(2, a.ref_batches);
   std::vector<FilmState> states(batches);
   RenderOptions o = base_options(a);
-  o.renderer = RendererKind::kTraditional;
+  o.lod = FullDetail{};
   const std::size_t n = static_cast<std::size_t>(a.width) * a.height;
   for (int each = std::min(16, std::max(1, a.ref_max_spp / batches));; each *= 2) {
     each = std::min(each, std::max(1, a.ref_max_spp / batches));
@@ -243,7 +243,7 @@ Run run_once(const Args& a, const std::string& kind, float k, int spp, std::uint
   LoadedScene s = load(a);
   RenderOptions o = base_options(a);
   o.spp = spp, o.seed = seed;
-  if (k > 0) o.footprint = k;
+  if (k > 0) o.lod = ByFootprint{k};
   if (kind == "scale-sensitive") o.opacity = *parse_opacity(a.opacity);
   if (a.light_samples > 0) {
     CameraChoice samples;  // the view as loaded, with --light-samples
@@ -258,7 +258,7 @@ Run run_once(const Args& a, const std::string& kind, float k, int spp, std::uint
     r.fixed = s.load_seconds + f.build_seconds;
     return r;
   }
-  o.renderer = kind == "traditional" ? RendererKind::kTraditional : RendererKind::kScaleSensitive;
+  if (kind == "traditional") o.lod = FullDetail{};
   RenderOutput out = render(s, o);
   r.image = std::move(out.image);
   r.render = out.seconds;

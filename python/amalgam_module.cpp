@@ -24,6 +24,7 @@
 #include "amalgam/io/colormap.h"
 #include "amalgam/io/stats_json.h"
 #include "amalgam/load/load_scene.h"
+#include "amalgam/render/option_rules.h"
 #include "amalgam/render/render.h"
 #include "amalgam/util/error.h"
 #include "amalgam/util/version.h"
@@ -65,49 +66,15 @@ Options make_options(int width, int height, int spp, const std::string& renderer
                      const std::string& opacity, std::optional<int> level,
                      std::optional<float> footprint, const std::string& order, std::uint64_t seed,
                      int threads, const std::string& sampler = "independent") {
-  // The checks and messages of the CLI (apps/amalgam/common.cpp, CommonOptions::finish).
-  if (renderer != "scale-sensitive" && renderer != "traditional" && renderer != "volumetric")
-    throw InputError("--renderer " + one_line(renderer, 40) +
-                     ": expected scale-sensitive, traditional or volumetric");
-  if (!parse_opacity(opacity))
-    throw InputError("--opacity " + one_line(opacity, 40) +
-                     ": expected stochastic, deterministic, prefiltered or composite");
-  if (order != "sorted" && order != "unsorted")
-    throw InputError("--order " + one_line(order, 40) + ": expected sorted or unsorted");
-  if (level && footprint)
-    throw InputError("--level and --footprint: give one (a fixed level, or render by footprint)");
-  if (renderer == "traditional" && (level || footprint))
-    throw InputError(std::string("--renderer traditional renders no amalgam: ") +
-                     (level ? "--level" : "--footprint") + " does not apply");
-  if (renderer == "volumetric" && level)
-    throw InputError("--renderer volumetric chooses cells by footprint: --level does not apply");
-  if (level && *level < 0)
-    throw InputError("--level " + std::to_string(*level) + ": expected an integer >= 0");
-  if (footprint && !(*footprint > 0.0f && *footprint < 1e30f))
-    throw InputError("--footprint: expected a number > 0");
-  if (width < 1)
-    throw InputError("--width " + std::to_string(width) + ": expected an integer >= 1");
-  if (height < 1)
-    throw InputError("--height " + std::to_string(height) + ": expected an integer >= 1");
-  if (spp < 1) throw InputError("--spp " + std::to_string(spp) + ": expected an integer >= 1");
-  if (threads < 0)
-    throw InputError("--threads " + std::to_string(threads) + ": expected an integer >= 0");
-  if (sampler != "independent" && sampler != "stratified")
-    throw InputError("--sampler " + one_line(sampler, 40) + ": expected independent or stratified");
+  // The CLI's checks (render/option_rules.h), its messages naming keywords.
+  OptionRequest q;
+  q.renderer = renderer, q.opacity = opacity, q.order = order, q.sampler = sampler;
+  q.level = level;
+  if (footprint) q.footprint = *footprint;
+  q.width = width, q.height = height, q.spp = spp, q.threads = threads;
+  q.seed = seed;
   Options r;
-  r.o.renderer = renderer == "traditional"  ? RendererKind::kTraditional
-                 : renderer == "volumetric" ? RendererKind::kVolumetric
-                                            : RendererKind::kScaleSensitive;
-  r.o.opacity = *parse_opacity(opacity);
-  r.o.level = level;
-  r.o.footprint = footprint ? *footprint : 1.0f;
-  r.o.sorted = order == "sorted";
-  r.o.seed = seed;
-  r.o.threads = threads;
-  r.o.sampler = sampler == "stratified" ? PixelSampler::kStratified : PixelSampler::kIndependent;
-  r.o.width = width;
-  r.o.height = height;
-  r.o.spp = spp;
+  r.o = resolve_options(q, OptionSpelling::kKeywords);
   return r;
 }
 
@@ -231,7 +198,7 @@ struct Scene {
                                        const py::object& fov, const py::object& light_samples) {
     const Options opt = make_options(width, height, spp, renderer, opacity, level, footprint, order,
                                      seed, threads, sampler);
-    check_options(*scene, opt.o);
+    check_options(*scene, opt.o, OptionSpelling::kKeywords);
     // Another view of the same built, baked scene: only the environment is new.
     CameraChoice view;
     const std::pair<const char*, const py::object*> keys[] = {
@@ -286,7 +253,7 @@ struct Scene {
                  std::optional<float> footprint, const std::string& order, std::uint64_t seed) {
     const Options opt =
         make_options(width, height, 1, renderer, opacity, level, footprint, order, seed, 1);
-    check_options(*scene, opt.o);
+    check_options(*scene, opt.o, OptionSpelling::kKeywords);
     Ray ray = scene->env.camera.centre_ray(width, height);
     auto vec = [](const std::vector<float>& v, const char* what) {
       if (v.size() != 3) throw InputError(std::string(what) + ": expected three numbers x,y,z");

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <system_error>
 
+#include "amalgam/render/option_rules.h"
+
 namespace amalgam::cli {
 
 void CommonOptions::add_to(CLI::App& app) {
@@ -72,47 +74,25 @@ void print_warnings(const LoadedScene& scene) {
 }
 
 void CommonOptions::finish() {
-  const bool level_given = level_option && level_option->count() > 0;
-  const bool footprint_given = footprint_option && footprint_option->count() > 0;
-  if (level_given && footprint_given)
-    throw InputError("--level and --footprint: give one (a fixed level, or render by footprint)");
-  if (renderer == "traditional" && (level_given || footprint_given))
-    throw InputError(std::string("--renderer traditional renders no amalgam: ") +
-                     (level_given ? "--level" : "--footprint") + " does not apply");
-  if (renderer == "volumetric" && level_given)
-    throw InputError("--renderer volumetric chooses cells by footprint: --level does not apply");
-  options.renderer = renderer == "traditional"  ? RendererKind::kTraditional
-                     : renderer == "volumetric" ? RendererKind::kVolumetric
-                                                : RendererKind::kScaleSensitive;
-  options.tracer = tracer == "embree" ? TracerKind::kEmbree : TracerKind::kAmalgam;
-  if (options.tracer == TracerKind::kEmbree) {
+  auto given = [](const CLI::Option* opt) { return opt && opt->count() > 0; };
+  OptionRequest r;
+  if (given(renderer_option)) r.renderer = renderer;
+  if (given(opacity_option)) r.opacity = opacity;
+  if (given(order_option)) r.order = order;
+  if (given(level_option)) r.level = level;
+  if (given(footprint_option)) r.footprint = footprint;
+  r.tracer = tracer;
+  r.sampler = sampler;
+  r.width = options.width, r.height = options.height, r.spp = options.spp;
+  r.threads = threads;
+  r.seed = parse_seed(seed);
 #if !defined(AMALGAM_HAVE_EMBREE)
+  if (tracer == "embree")
     throw InputError(
         "--tracer embree: this amalgam was built without Embree (install libembree-dev, "
         "reconfigure with -DAMALGAM_EMBREE=ON)");
 #endif
-    // Embree renders every primitive (full detail): the options that choose amalgams, blend
-    // them or order amalgam's own traversal have no meaning there.
-    auto refuse = [](const std::string& what) {
-      throw InputError("--tracer embree renders at full detail: " + what + " does not apply");
-    };
-    if (renderer_option && renderer_option->count() > 0 && renderer != "traditional")
-      refuse("--renderer " + renderer);
-    if (level_given) refuse("--level");
-    if (footprint_given) refuse("--footprint");
-    if (opacity_option && opacity_option->count() > 0 && opacity != "stochastic")
-      refuse("--opacity " + opacity);
-    if (order_option && order_option->count() > 0) refuse("--order (Embree orders its own)");
-    options.renderer = RendererKind::kTraditional;
-  }
-  options.opacity = parse_opacity(opacity).value_or(OpacityKind::kStochastic);
-  options.sorted = order == "sorted";
-  options.level = level >= 0 ? std::optional<int>(level) : std::nullopt;
-  options.footprint = footprint;
-  options.seed = parse_seed(seed);
-  options.sampler =
-      sampler == "stratified" ? PixelSampler::kStratified : PixelSampler::kIndependent;
-  options.threads = threads;
+  options = resolve_options(r, OptionSpelling::kFlags);
   view = CameraChoice{};
   view.camera = camera;
   if (!eye.empty()) view.eye = parse_vec3(eye, "--eye");

@@ -56,6 +56,14 @@ extern "C" void on_signal(int sig) {
   }
 }
 
+/// The --footprint value of `lod` (1, the default, where there is none), as fingerprints and
+/// the EXR header spell it.
+float footprint_of(const LevelOfDetail& lod) {
+  if (const auto* f = std::get_if<ByFootprint>(&lod)) return f->pixels;
+  if (const auto* c = std::get_if<VolumetricCells>(&lod)) return c->cone_widths;
+  return 1.0f;
+}
+
 /// Everything that determines the image except spp and threads: the renderer options and the
 /// scene as loaded (content_hash: its geometry, lights and camera, or a builtin's parameters
 /// as applied). A checkpoint is only resumed under the same fingerprint.
@@ -65,10 +73,10 @@ std::string fingerprint(const CommonOptions& c, const LoadedScene& scene) {
   f << c.scene << " (scene " << std::hex << content_hash(scene) << std::dec << ")"
     << " --renderer " << c.renderer << " --opacity " << c.opacity << " --order " << c.order
     << " --seed " << o.seed << " --width " << o.width << " --height " << o.height;
-  if (o.level)
-    f << " --level " << *o.level;
+  if (const auto* l = std::get_if<OnLevel>(&o.lod))
+    f << " --level " << l->level;
   else
-    f << " --footprint " << o.footprint;
+    f << " --footprint " << footprint_of(o.lod);
   if (o.tracer == TracerKind::kEmbree) f << " --tracer embree";  // amalgam's: as before
   // Only when not the default, so checkpoints written before the option existed still resume.
   if (o.sampler == PixelSampler::kStratified) f << " --sampler stratified";
@@ -172,12 +180,10 @@ std::string options_text(const CommonOptions& c, int spp) {
   const RenderOptions& o = c.options;
   std::ostringstream f;
   f << "--renderer " << c.renderer << " --opacity " << c.opacity << " --order " << c.order;
-  if (o.renderer != RendererKind::kTraditional) {
-    if (o.level)
-      f << " --level " << *o.level;
-    else
-      f << " --footprint " << o.footprint;
-  }
+  if (const auto* l = std::get_if<OnLevel>(&o.lod))
+    f << " --level " << l->level;
+  else if (o.renderer() != RendererKind::kTraditional)
+    f << " --footprint " << footprint_of(o.lod);
   f << " --seed " << o.seed << " --width " << o.width << " --height " << o.height << " --spp "
     << spp << " --threads " << render_threads(o);
   return f.str();
@@ -239,7 +245,7 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
     budget.max_bytes = limit - film;
     budget.limit_name = "--max-memory " + format_bytes(static_cast<double>(limit)) + " less " +
                         format_bytes(static_cast<double>(film)) + " for the film";
-    budget.objects = o.renderer == RendererKind::kVolumetric;
+    budget.objects = o.renderer() == RendererKind::kVolumetric;
     budget.on_phase = [&](const std::string& what) {
       set_activity(what);
       status.phase(what);
@@ -449,7 +455,7 @@ int run_trace(CommonOptions& common, const std::string& origin, const std::strin
   common.finish();
   set_activity("loading and building " + common.scene);
   SceneFileConfig config;
-  config.objects = common.options.renderer == RendererKind::kVolumetric;
+  config.objects = common.options.renderer() == RendererKind::kVolumetric;
   LoadedScene scene = load_scene(common.scene, common.params(), config);
   common.prepare(scene);
   print_warnings(scene);

@@ -310,7 +310,7 @@ TEST(Watertight, ThroughTheHierarchy) {
   const Mesh m = icosphere(3).transformed(2.0f, {1e3f, -5e2f, 2.5e2f});
   LoadedScene s{"icosphere", build_explicit(m.primitives(), {Surface{}}), Environment{}};
   RenderOptions o;
-  o.renderer = RendererKind::kTraditional;
+  o.lod = FullDetail{};
   const Topology topo = topology(m);
   std::mt19937 rng(9);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
@@ -349,7 +349,8 @@ std::vector<RenderOutput> render_prims(std::vector<Primitive> prims, const Camer
   std::vector<RenderOutput> out;
   for (RendererKind r : {RendererKind::kTraditional, RendererKind::kScaleSensitive})
     for (OpacityKind op : {OpacityKind::kStochastic, OpacityKind::kDeterministic}) {
-      o.renderer = r, o.opacity = op;
+      o.lod = r == RendererKind::kTraditional ? LevelOfDetail{FullDetail{}} : LevelOfDetail{};
+      o.opacity = op;
       out.push_back(render(s, o));
     }
   return out;
@@ -537,7 +538,7 @@ LitCheck check_lit(const LoadedScene& s, Vec3 light_dir, const std::vector<Ray>&
                    float min_cos, const std::function<bool(Vec3)>& unoccluded) {
   LitCheck r;
   RenderOptions o;
-  o.renderer = RendererKind::kTraditional;
+  o.lod = FullDetail{};
   for (const Ray& ray : rays) {
     const TraceOutput t = trace(s, o, ray);
     if (t.hit.kind != TraceHit::Kind::kPrimitive) continue;

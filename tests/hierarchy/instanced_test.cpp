@@ -100,7 +100,7 @@ std::vector<Transform> rotated() {
 
 RenderOptions traditional() {
   RenderOptions o;
-  o.renderer = RendererKind::kTraditional;
+  o.lod = FullDetail{};
   o.width = 64;
   o.height = 48;
   o.spp = 1;
@@ -173,7 +173,7 @@ TEST(Instanced, CountsAddUpAndLevelsRunThroughInstances) {
     RenderOptions o = base;
     o.width = 48, o.height = 32, o.spp = 2;
     for (float k : {1.0f, 8.0f}) {
-      o.footprint = k;
+      if (!std::holds_alternative<FullDetail>(base.lod)) o.lod = ByFootprint{k};
       const RenderOutput r = render(p.instanced, o);
       const Counters& c = r.counters;
       std::uint64_t by_level = 0;

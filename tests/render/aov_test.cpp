@@ -75,7 +75,7 @@ TEST(Aov, BackgroundPrimitivesAndRenderedLevels) {
   const LoadedScene s = prisms("corner");
   RenderOptions o;
   o.width = 64, o.height = 64, o.spp = 2;
-  o.renderer = RendererKind::kTraditional;
+  o.lod = FullDetail{};
   const RenderOutput trad = render(s, o);
   int background = 0, hit = 0;
   for (std::size_t i = 0; i < trad.level.size(); ++i) {
@@ -100,8 +100,7 @@ TEST(Aov, BackgroundPrimitivesAndRenderedLevels) {
   EXPECT_GT(length(trad.normal[centre]), 0.5f);
 
   // At a fixed level every rendered amalgam is on that level: the level output is exactly it.
-  o.renderer = RendererKind::kScaleSensitive;
-  o.level = 2;
+  o.lod = OnLevel{2};
   const RenderOutput fixed = render(s, o);
   int on_level = 0;
   for (std::size_t i = 0; i < fixed.level.size(); ++i) {
@@ -123,7 +122,7 @@ TEST(Aov, ACompositeBlendThatSaturatesIsWhereTheRayEnded) {
       load_scene(std::string(AMALGAM_SOURCE_DIR) + "/tests/data/bias-meadow.json", Params{});
   RenderOptions o;
   o.opacity = OpacityKind::kComposite;
-  o.footprint = 2;
+  o.lod = ByFootprint{2};
   o.width = 64, o.height = 48, o.spp = 1, o.threads = 2;
   const RenderOutput out = render(s, o);
   int nothing = 0, amalgams = 0;

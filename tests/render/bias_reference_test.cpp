@@ -99,7 +99,7 @@ struct Measured {
 Measured render_composite(const LoadedScene& scene, float footprint, int spp) {
   RenderOptions o;
   o.opacity = OpacityKind::kComposite;
-  o.footprint = footprint;
+  o.lod = ByFootprint{footprint};
   o.sampler = PixelSampler::kStratified;
   o.width = kWidth, o.height = kHeight, o.spp = spp, o.threads = 2;
   check_options(scene, o);

@@ -49,7 +49,7 @@ LoadedScene load(const Case& c) {
 RenderOptions one_spp(TracerKind tracer) {
   RenderOptions o;
   o.width = 128, o.height = 96, o.spp = 1;
-  o.renderer = RendererKind::kTraditional;
+  o.lod = FullDetail{};
   o.tracer = tracer;
   return o;
 }
@@ -136,7 +136,7 @@ TEST(Embree, RefusesWhatItCannotDo) {
   const LoadedScene scene = load({"builtin:prisms", {"depth=3"}});
   const EmbreeScene es(scene);
   RenderOptions o = one_spp(TracerKind::kEmbree);
-  o.renderer = RendererKind::kScaleSensitive;  // amalgams: not Embree's
+  o.lod = ByFootprint{};  // amalgams: not Embree's
   EXPECT_THROW(render_embree(es, o), InputError);
   EXPECT_THROW(render_embree(es, one_spp(TracerKind::kAmalgam)), InputError);
   EXPECT_THROW(render(scene, one_spp(TracerKind::kEmbree)), InputError);

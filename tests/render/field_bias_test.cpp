@@ -333,10 +333,10 @@ TEST(FieldBias, FarBandMatchesTraditional) {
   const Field f = small_field();
   RenderOptions o;
   o.width = 96, o.height = 72, o.spp = 16, o.threads = 2;
-  o.renderer = RendererKind::kTraditional;
+  o.lod = FullDetail{};
   const RenderOutput trad = render(f.scene, o);
-  o.renderer = RendererKind::kScaleSensitive;
-  o.footprint = 6.0f;  // the blobs are coarse: amalgams of the size the field renders at K = 1
+  o.lod =
+      ByFootprint{6.0f};  // the blobs are coarse: amalgams of the size the field renders at K = 1
   const RenderOutput ss = render(f.scene, o);
   const double lt = band_luminance(trad, f, 10.0f, 36.0f);
   const double ls = band_luminance(ss, f, 10.0f, 36.0f);

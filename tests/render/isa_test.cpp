@@ -51,13 +51,13 @@ std::vector<std::pair<std::string, RenderOptions>> policies(int levels) {
       const std::string n = std::string(op == OpacityKind::kStochastic ? "stochastic" : "det") +
                             (sorted ? " sorted" : " stored");
       RenderOptions t = o;
-      t.renderer = RendererKind::kTraditional;
+      t.lod = FullDetail{};
       out.push_back({n + " traditional", t});
       RenderOptions f = o;
-      f.footprint = 4.0f;
+      f.lod = ByFootprint{4.0f};
       out.push_back({n + " footprint 4", f});
       RenderOptions l = o;
-      l.level = levels / 2;
+      l.lod = OnLevel{levels / 2};
       out.push_back({n + " level", l});
     }
   return out;

@@ -36,7 +36,7 @@ LoadedScene floor_scene(const std::string& light, const std::string& extra = "")
 
 RenderOutput render_traditional(const LoadedScene& s, int spp, std::uint64_t seed = 1) {
   RenderOptions o;
-  o.renderer = RendererKind::kTraditional;
+  o.lod = FullDetail{};
   o.width = 24, o.height = 24, o.spp = spp, o.seed = seed, o.threads = 2;
   return render(s, o);
 }
@@ -160,7 +160,7 @@ TEST(PrefilteredOpacity, HasTheExpectationOfStochasticShadowsWithLessNoise) {
   // stochastic one with each shadow ray's decision replaced by its expectation.
   const LoadedScene s = field_from_above();
   RenderOptions o;
-  o.footprint = 16.0f, o.width = 32, o.height = 24, o.threads = 2;
+  o.lod = ByFootprint{16.0f}, o.width = 32, o.height = 24, o.threads = 2;
   auto image = [&](OpacityKind k, int spp, std::uint64_t seed) {
     o.opacity = k, o.spp = spp, o.seed = seed;
     return render(s, o).image;
@@ -193,7 +193,7 @@ TEST(CompositeOpacity, HasTheDeterministicImageWithOneShadowRayPerLightPerSample
   const LoadedScene s = field_from_above();
   ASSERT_EQ(s.env.lights.size(), 1u);
   RenderOptions o;
-  o.footprint = 16.0f, o.width = 32, o.height = 24, o.threads = 2, o.seed = 9;
+  o.lod = ByFootprint{16.0f}, o.width = 32, o.height = 24, o.threads = 2, o.seed = 9;
   o.opacity = OpacityKind::kDeterministic, o.spp = 64;
   const RenderOutput det = render(s, o);
   o.opacity = OpacityKind::kComposite, o.spp = 256;

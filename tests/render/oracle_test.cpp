@@ -40,7 +40,7 @@ TEST(Oracle, IsTheTraditionalRendererWhereNoAmalgamRenders) {
   const LoadedScene s = field();
   RenderOptions o;
   o.width = 48, o.height = 36, o.spp = 2, o.seed = 4, o.sampler = PixelSampler::kStratified;
-  o.renderer = RendererKind::kTraditional;
+  o.lod = FullDetail{};
   const RenderOutput trad = render(s, o);
   std::uint64_t in_amalgam = 1;
   const std::vector<Vec3> tiny = oracle_image(s, o, 1e-6f, false, in_amalgam);

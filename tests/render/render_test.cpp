@@ -28,9 +28,9 @@ RenderOptions small(int w = 48, int h = 40, int spp = 2) {
 TEST(Render, DeepestLevelEqualsTraditional) {
   const LoadedScene s = prisms(4);
   RenderOptions trad = small();
-  trad.renderer = RendererKind::kTraditional;
+  trad.lod = FullDetail{};
   RenderOptions deepest = small();
-  deepest.level = s.info().levels - 1;  // l_max: no amalgam is ever rendered
+  deepest.lod = OnLevel{s.info().levels - 1};  // l_max: no amalgam is ever rendered
   for (OpacityKind op : {OpacityKind::kStochastic, OpacityKind::kDeterministic}) {
     trad.opacity = deepest.opacity = op;
     const RenderOutput a = render(s, trad), b = render(s, deepest);
@@ -47,7 +47,7 @@ TEST(Render, ThreadCountDoesNotChangeTheImage) {
   for (bool level : {false, true}) {
     RenderOptions o = small(64, 48, 3);
     o.seed = 1234;
-    if (level) o.level = 2;
+    if (level) o.lod = OnLevel{2};
     o.threads = 1;
     const RenderOutput one = render(s, o);
     o.threads = 2;
@@ -65,7 +65,7 @@ TEST(Render, ThreadCountDoesNotChangeTheImage) {
 TEST(Render, SeedChangesStochasticImage) {
   const LoadedScene s = prisms(5);
   RenderOptions o = small(32, 32, 1);
-  o.level = 3;
+  o.lod = OnLevel{3};
   const RenderOutput a = render(s, o);
   o.seed = 99;
   const RenderOutput b = render(s, o);
@@ -76,13 +76,13 @@ TEST(Render, SeedChangesStochasticImage) {
 
 TEST(Render, FixedLevelMeanCostIsIndependentOfDepth) {
   RenderOptions o = small(40, 40, 2);
-  o.level = 3;
+  o.lod = OnLevel{3};
   const LoadedScene shallow = prisms(6, "front"), deep = prisms(12, "front");
   const RenderOutput a = render(shallow, o), b = render(deep, o);
   EXPECT_EQ(a.per_primary.mean(), b.per_primary.mean());
   EXPECT_EQ(a.counters.total(), b.counters.total());
   RenderOptions t = small(8, 8, 1);
-  t.renderer = RendererKind::kTraditional;
+  t.lod = FullDetail{};
   EXPECT_LT(render(prisms(4, "front"), t).per_primary.mean(),
             render(prisms(6, "front"), t).per_primary.mean());
 }
@@ -90,7 +90,7 @@ TEST(Render, FixedLevelMeanCostIsIndependentOfDepth) {
 TEST(Render, CountsAddUp) {
   const LoadedScene s = prisms(5);
   RenderOptions o = small();
-  o.footprint = 2.0f;
+  o.lod = ByFootprint{2.0f};
   const RenderOutput r = render(s, o);
   const Counters& c = r.counters;
   std::uint64_t levels = 0;
@@ -133,7 +133,7 @@ TEST(Render, StochasticOpacityIsUnbiased) {
     s.env.lights = {l};
 
     RenderOptions det = small(1, 1, 1);
-    det.level = 1;
+    det.lod = OnLevel{1};
     det.opacity = OpacityKind::kDeterministic;
     const Vec3 expected = render(s, det).image[0];
     const Vec3 c_amalgam = amalgam.surface.colour * (3.0f / 3.14159265f);
@@ -162,8 +162,8 @@ TEST(Render, ExplicitFlattenMatchesImplicit) {
   LoadedScene flat{"flat", flatten(std::get<TubeHierarchy>(implicit.hierarchy), 5), implicit.env};
   for (RendererKind r : {RendererKind::kTraditional, RendererKind::kScaleSensitive}) {
     RenderOptions o;
-    o.renderer = r;
-    o.level = 2;
+    o.lod =
+        r == RendererKind::kTraditional ? LevelOfDetail{FullDetail{}} : LevelOfDetail{OnLevel{2}};
     o.opacity = OpacityKind::kDeterministic;
     const Ray ray = implicit.env.camera.centre_ray(o.width, o.height);
     const TraceOutput a = trace(implicit, o, ray), b = trace(flat, o, ray);

@@ -100,7 +100,7 @@ LoadedScene edge_scene() {
 TEST(StratifiedSampler, ConvergesFasterThanIndependentOnEdges) {
   const LoadedScene s = edge_scene();
   RenderOptions o;
-  o.width = 48, o.height = 48, o.renderer = RendererKind::kTraditional;
+  o.width = 48, o.height = 48, o.lod = FullDetail{};
   o.spp = 4096, o.seed = 777;  // reference: independent, its own seed
   const RenderOutput ref = render(s, o);
   for (int spp : {4, 16, 64}) {

@@ -48,7 +48,7 @@ LoadedScene load_objects(const std::string& path, bool correlated = true) {
 
 RenderOptions volumetric(int width, int height, int spp) {
   RenderOptions o;
-  o.renderer = RendererKind::kVolumetric;
+  o.lod = VolumetricCells{};
   o.sampler = PixelSampler::kStratified;
   o.width = width, o.height = height, o.spp = spp, o.threads = 2, o.seed = 1;
   return o;
@@ -109,7 +109,7 @@ double tuft_coverage(RendererKind kind, bool correlated, int spp) {
   const LoadedScene scene =
       load_objects(std::string(AMALGAM_SOURCE_DIR) + "/tests/data/tuft-coverage.json", correlated);
   RenderOptions o = volumetric(32, 24, spp);
-  o.renderer = kind;
+  if (kind == RendererKind::kTraditional) o.lod = FullDetail{};
   const RenderOutput out = render(scene, o);
   double covered = 0;
   for (const Vec3& p : out.image) covered += 1.0 - luminance(p);
@@ -186,7 +186,7 @@ TEST(Volumetric, CloseUpIsFullDetail) {
   scene.env.camera.look_at = {0.0f, 0.2f, 0.0f};
   RenderOptions o = volumetric(128, 96, 1);
   const RenderOutput v = render(scene, o);
-  o.renderer = RendererKind::kTraditional;
+  o.lod = FullDetail{};
   const RenderOutput t = render(scene, o);
   ASSERT_EQ(v.image.size(), t.image.size());
   double worst = 0;

@@ -41,7 +41,7 @@ TEST_P(TraditionalLine, PrimaryAndShadowRayExamineEveryObject) {
   const LoadedScene s = line(n, depth);
   for (bool sorted : {true, false}) {
     RenderOptions o;
-    o.renderer = RendererKind::kTraditional;
+    o.lod = FullDetail{};
     o.sorted = sorted;
     const TraceOutput t = trace_centre(s, o);
     const std::uint64_t c_t0 = geometric_sum(n, depth);  // (n^(l_max+1) - 1) / (n - 1)
@@ -66,7 +66,7 @@ INSTANTIATE_TEST_SUITE_P(Paper, TraditionalLine,
 
 TEST(TraditionalLine, ContractExample) {
   RenderOptions o;
-  o.renderer = RendererKind::kTraditional;
+  o.lod = FullDetail{};
   EXPECT_EQ(trace_centre(line(3, 6), o).counters.tests_of(RayKind::kPrimary), 1093u);
 }
 
@@ -80,7 +80,7 @@ TEST(ScaleSensitiveLine, StochasticCostIsIndependentOfDepth) {
       for (int depth : {l1 + 1, l1 + 3, 12, 19}) {
         if (std::pow(n, depth) >= 0x1.0p58) continue;
         RenderOptions o;
-        o.level = l1;
+        o.lod = OnLevel{l1};
         const TraceOutput t = trace_centre(line(n, depth), o);
         EXPECT_EQ(t.counters.tests_of(RayKind::kPrimary), c_s0)
             << "Eq. 1, n=" << n << " l1=" << l1 << " l_max=" << depth;
@@ -112,7 +112,7 @@ TEST(ScaleSensitiveLine, DeterministicShadowCostGrowsAsNToTheTwoL1) {
     double previous = 0;
     for (int l1 = 1; l1 <= 5; ++l1) {
       RenderOptions o;
-      o.level = l1;
+      o.lod = OnLevel{l1};
       o.opacity = OpacityKind::kDeterministic;
       const TraceOutput t = trace_centre(line(n, l1 + 2, 0.5), o);
       const std::uint64_t b = static_cast<std::uint64_t>(std::pow(n, l1));
@@ -134,7 +134,7 @@ TEST(ScaleSensitiveLine, DeterministicShadowCostGrowsAsNToTheTwoL1) {
 TEST(ScaleSensitiveLine, LightsScaleShadowCost) {
   for (int lights : {1, 2, 5}) {
     RenderOptions o;
-    o.level = 2;
+    o.lod = OnLevel{2};
     const TraceOutput t = trace_centre(line(3, 6, 0.0, lights), o);
     EXPECT_EQ(t.counters.tests_of(RayKind::kShadow), lights * geometric_sum(3, 2));
   }
@@ -151,7 +151,7 @@ TEST(ObjectsTraversed, WorstCaseIsCs0AndFirstHitIsEq4) {
   for (int n : {2, 3, 8}) {
     for (int l1 = 1; l1 <= (n == 8 ? 3 : 6); ++l1) {
       RenderOptions o;
-      o.level = l1;
+      o.lod = OnLevel{l1};
       const TraceOutput w = trace_centre(line(n, l1 + 1), o);
       EXPECT_EQ(w.counters.traversed_of(RayKind::kPrimary), geometric_sum(n, l1))
           << "n=" << n << " l1=" << l1;

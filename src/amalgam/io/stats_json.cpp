@@ -22,13 +22,15 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
   using nlohmann::json;
   const HierarchyInfo info = scene.info();
   json j;
-  j["renderer"] = o.renderer == RendererKind::kTraditional  ? "traditional"
-                  : o.renderer == RendererKind::kVolumetric ? "volumetric"
-                                                            : "scale-sensitive";
+  j["renderer"] = std::string(renderer_name(o.renderer()));
   j["opacity"] = std::string(opacity_name(o.opacity));
-  const bool ss = o.renderer != RendererKind::kTraditional;
-  j["level"] = (ss && o.level) ? json(*o.level) : json(nullptr);
-  j["footprint"] = (ss && !o.level) ? json(o.footprint) : json(nullptr);
+  const auto* on_level = std::get_if<OnLevel>(&o.lod);
+  const auto* by_footprint = std::get_if<ByFootprint>(&o.lod);
+  const auto* cells = std::get_if<VolumetricCells>(&o.lod);
+  j["level"] = on_level ? json(on_level->level) : json(nullptr);
+  j["footprint"] = by_footprint ? json(by_footprint->pixels)
+                   : cells      ? json(cells->cone_widths)
+                                : json(nullptr);
   j["order"] = o.sorted ? "sorted" : "unsorted";
   const bool embree = o.tracer == TracerKind::kEmbree;
   j["tracer"] = embree ? "embree" : "amalgam";

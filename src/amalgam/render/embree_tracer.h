@@ -49,7 +49,7 @@ class EmbreeScene {
 };
 
 /// `render` (render.h) with Embree as the ray tracer: the same progressive passes, resume and
-/// control. `options.renderer` must be traditional (full detail), `options.tracer` embree
+/// control. `options.lod` must be FullDetail (the traditional renderer), `options.tracer` embree
 /// (InputError otherwise). The output's counters hold the rays traced; its test counts and
 /// per-pixel costs are zero (Embree does not count tests).
 RenderOutput render_embree(const EmbreeScene& scene, const RenderOptions& options,

@@ -5,14 +5,48 @@
 #include <cstdint>
 #include <optional>
 #include <string_view>
+#include <variant>
 
 namespace amalgam {
 
-/// kVolumetric: every object (an instanced mesh) whose cells the ray's cone is wide enough for
-/// is rendered as volumetric amalgams (hierarchy/volume/cells.h), the rest at full detail;
-/// `footprint` is then the cells' size in cone widths. Needs a scene loaded with
-/// SceneFileConfig::objects (io/scene_json.h).
+/// The renderers (--renderer), as named in the stats JSON; which one a LevelOfDetail is.
 enum class RendererKind : std::uint8_t { kScaleSensitive, kTraditional, kVolumetric };
+
+/// The level-of-detail choice: one type per way of choosing, so that an option that does not
+/// apply to a renderer cannot be set for it (render/option_rules.h turns the CLI's flags and
+/// Python's keywords into one).
+///
+/// Scale-sensitive, by footprint (the default): render an amalgam once its box diagonal is
+/// smaller than `pixels` widths of the ray's cone (--footprint K).
+struct ByFootprint {
+  float pixels = 1.0f;
+};
+/// Scale-sensitive on a fixed level: render the amalgams met on `level`, never deeper (--level).
+struct OnLevel {
+  int level = 0;
+};
+/// Traditional: every amalgam is a plain bounding volume, always traversed (full detail).
+struct FullDetail {};
+/// Volumetric: every object (an instanced mesh) whose cells the ray's cone is wide enough for is
+/// rendered as volumetric amalgams (hierarchy/volume/cells.h), the rest at full detail; cells
+/// of `cone_widths` widths of the ray's cone. Needs a scene loaded with
+/// SceneFileConfig::objects (io/scene_json.h).
+struct VolumetricCells {
+  float cone_widths = 1.0f;
+};
+using LevelOfDetail = std::variant<ByFootprint, OnLevel, FullDetail, VolumetricCells>;
+
+inline RendererKind renderer_of(const LevelOfDetail& l) {
+  if (std::holds_alternative<FullDetail>(l)) return RendererKind::kTraditional;
+  if (std::holds_alternative<VolumetricCells>(l)) return RendererKind::kVolumetric;
+  return RendererKind::kScaleSensitive;
+}
+/// --renderer's name of each RendererKind.
+inline std::string_view renderer_name(RendererKind k) {
+  return k == RendererKind::kTraditional  ? "traditional"
+         : k == RendererKind::kVolumetric ? "volumetric"
+                                          : "scale-sensitive";
+}
 /// The opacity models (traverse/opacity.h): the paper's two, and kPrefiltered, stochastic for
 /// camera rays and deterministic (prefiltered) attenuation for shadow rays.
 /// kComposite: deterministic for every ray, camera rays stopping when their coverage saturates,
@@ -39,11 +73,12 @@ enum class TracerKind : std::uint8_t { kAmalgam, kEmbree };
 /// of 2^m samples covers the pixel evenly, so edges converge faster.
 enum class PixelSampler : std::uint8_t { kIndependent, kStratified };
 
+/// How messages name an option: kFlags `--level 3` (the CLI), kKeywords `level=3` (Python).
+enum class OptionSpelling : std::uint8_t { kFlags, kKeywords };
+
 struct RenderOptions {
-  RendererKind renderer = RendererKind::kScaleSensitive;
+  LevelOfDetail lod{};
   OpacityKind opacity = OpacityKind::kStochastic;
-  std::optional<int> level;  ///< scale-sensitive: render the amalgams met on this level
-  float footprint = 1.0f;    ///< scale-sensitive without level: pixels of ray footprint
   bool sorted = true;
   std::uint64_t seed = 0;
   PixelSampler sampler = PixelSampler::kIndependent;
@@ -52,6 +87,8 @@ struct RenderOptions {
   int height = 512;
   int spp = 4;
   TracerKind tracer = TracerKind::kAmalgam;
+
+  RendererKind renderer() const { return renderer_of(lod); }
 };
 
 }  // namespace amalgam

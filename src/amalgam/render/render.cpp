@@ -6,30 +6,37 @@
 #include <chrono>
 #include <type_traits>
 
+#include "amalgam/render/option_rules.h"
 #include "amalgam/render/render_isa.h"
 #include "amalgam/util/isa.h"
 
 namespace amalgam {
 
-void check_options(const LoadedScene& scene, const RenderOptions& o) {
+void check_options(const LoadedScene& scene, const RenderOptions& o, OptionSpelling spelling) {
   const int levels = scene.info().levels;
-  if (o.level && (*o.level < 0 || *o.level >= levels))
-    throw InputError("--level " + std::to_string(*o.level) + ": expected a level in [0, " +
-                     std::to_string(levels - 1) + "] for " + scene.name);
-  if (!(o.footprint > 0.0f)) throw InputError("--footprint: expected a number > 0");
+  const auto* on_level = std::get_if<OnLevel>(&o.lod);
+  if (on_level && (on_level->level < 0 || on_level->level >= levels))
+    throw InputError(option_text("--level", spelling, std::to_string(on_level->level)) +
+                     ": expected a level in [0, " + std::to_string(levels - 1) + "] for " +
+                     scene.name);
+  const auto* by_footprint = std::get_if<ByFootprint>(&o.lod);
+  const auto* cells = std::get_if<VolumetricCells>(&o.lod);
+  if ((by_footprint && !(by_footprint->pixels > 0.0f)) || (cells && !(cells->cone_widths > 0.0f)))
+    throw InputError(option_text("--footprint", spelling) + ": expected a number > 0");
   if (o.width < 1 || o.height < 1 || o.spp < 1)
-    throw InputError("--width, --height and --spp must be at least 1");
-  if (o.tracer == TracerKind::kEmbree && o.renderer != RendererKind::kTraditional)
-    throw InputError("--tracer embree renders at full detail: only --renderer traditional");
-  if (o.renderer == RendererKind::kVolumetric) {
-    if (o.level)
-      throw InputError(
-          "--renderer volumetric chooses its cells by footprint: --level does not apply");
+    throw InputError(option_text("--width", spelling) + ", " + option_text("--height", spelling) +
+                     " and " + option_text("--spp", spelling) + " must be at least 1");
+  if (o.tracer == TracerKind::kEmbree && o.renderer() != RendererKind::kTraditional)
+    throw InputError(option_text("--tracer", spelling, "embree") +
+                     " renders at full detail: only " +
+                     option_text("--renderer", spelling, "traditional"));
+  if (cells) {
     if (o.opacity != OpacityKind::kStochastic)
-      throw InputError(
-          "--renderer volumetric composites its cells by coverage: --opacity does not apply");
+      throw InputError(option_text("--renderer", spelling, "volumetric") +
+                       " composites its cells by coverage: " + option_text("--opacity", spelling) +
+                       " does not apply");
     if (!scene.volumes || !std::holds_alternative<InstancedHierarchy>(scene.hierarchy))
-      throw InputError("--renderer volumetric: " + scene.name +
+      throw InputError(option_text("--renderer", spelling, "volumetric") + ": " + scene.name +
                        " was loaded without volumetric amalgams (load it for the volumetric "
                        "renderer; builtin scenes have none)");
   }

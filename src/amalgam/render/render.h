@@ -144,6 +144,7 @@ int render_threads(const RenderOptions& options);
 
 /// Throws InputError when options do not fit the scene (e.g. --level beyond l_max) or the
 /// tracer (Embree renders at full detail only: the traditional renderer).
-void check_options(const LoadedScene& scene, const RenderOptions& options);
+void check_options(const LoadedScene& scene, const RenderOptions& options,
+                   OptionSpelling spelling = OptionSpelling::kFlags);
 
 }  // namespace amalgam

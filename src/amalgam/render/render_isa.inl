@@ -35,9 +35,10 @@ auto dispatch(const LoadedScene& scene, const RenderOptions& o, F&& f) {
           if (o.opacity == OpacityKind::kComposite) return with_opacity(CompositeOpacity{});
           return with_opacity(DeterministicOpacity{});
         };
-        if (o.renderer == RendererKind::kTraditional) return with_lod(TraditionalLod{});
-        if (o.level) return with_lod(FixedLevelLod{*o.level});
-        return with_lod(FootprintLod{o.footprint});
+        if (const auto* l = std::get_if<OnLevel>(&o.lod)) return with_lod(FixedLevelLod{l->level});
+        if (const auto* f = std::get_if<ByFootprint>(&o.lod))
+          return with_lod(FootprintLod{f->pixels});
+        return with_lod(TraditionalLod{});  // full detail (volumetric: its other objects too)
       },
       scene.hierarchy);
 }
@@ -46,10 +47,11 @@ auto dispatch(const LoadedScene& scene, const RenderOptions& o, F&& f) {
 /// returns true; else returns false (check_options has made sure the scene has cells).
 template <class F>
 bool with_volumes(const LoadedScene& scene, const Environment& env, const RenderOptions& o, F&& f) {
-  if (o.renderer != RendererKind::kVolumetric) return false;
+  const auto* cells = std::get_if<VolumetricCells>(&o.lod);
+  if (!cells) return false;
   const auto& h = std::get<InstancedHierarchy>(scene.hierarchy);
   const VolumeSet& v = *scene.volumes;
-  f([&](Counters& c) { return VolumeIntegrator(h, v, env, o.footprint, c); });
+  f([&](Counters& c) { return VolumeIntegrator(h, v, env, cells->cone_widths, c); });
   return true;
 }
 

@@ -44,13 +44,13 @@ inline TraceOutput trace_centre(const LoadedScene& s, const RenderOptions& o) {
 
 inline RenderOptions traditional() {
   RenderOptions o;
-  o.renderer = RendererKind::kTraditional;
+  o.lod = FullDetail{};
   return o;
 }
 
 inline RenderOptions at_level(int l1, OpacityKind op = OpacityKind::kStochastic) {
   RenderOptions o;
-  o.level = l1;
+  o.lod = OnLevel{l1};
   o.opacity = op;
   return o;
 }

@@ -106,7 +106,7 @@ ExperimentResult premise(const Config& c) {
     for (int l : sp.levels) configs.push_back(l);
     for (int cfg : configs) {
       RenderOptions o = cfg == -2 ? traditional() : cfg == -1 ? RenderOptions{} : at_level(cfg);
-      if (cfg == -1) o.footprint = 1.0f;
+      if (cfg == -1) o.lod = ByFootprint{1.0f};
       o.width = o.height = size;
       o.spp = 1;
       o.threads = c.threads;
