@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -12,6 +13,7 @@
 #include "amalgam/builtin/params.h"
 #include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
+#include "amalgam/util/atomic_file.h"
 #include "common.h"
 
 namespace amalgam::cli {
@@ -37,6 +39,14 @@ std::string format_number(double v) {
 }  // namespace
 
 int run_compare(const CompareOptions& o) {
+  if (!o.error_image.empty()) {
+    check_writable(o.error_image);
+    const std::string out = file_identity(o.error_image);
+    for (const std::string* in : {&o.a, &o.b})
+      if (!out.empty() && std::filesystem::exists(*in) && out == file_identity(*in))
+        throw InputError("--error-image " + o.error_image + ": the input " + *in +
+                         " itself (an output never replaces an input)");
+  }
   int wa = 0, ha = 0, wb = 0, hb = 0;
   const std::vector<Vec3> a = read_input(o.a, wa, ha);
   const std::vector<Vec3> b = read_input(o.b, wb, hb);

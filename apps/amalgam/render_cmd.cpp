@@ -84,8 +84,11 @@ std::string fingerprint(const CommonOptions& c, const LoadedScene& scene) {
 }
 
 /// Checks every output path before any work: an image path must name a format we write, every
-/// path must be writable, and no two outputs may be the same file. Throws InputError.
-void check_outputs(const RenderExtras& e, const std::string& ckpt, const RenderOptions& ro) {
+/// path must be writable, no two outputs may be the same file and none may be the scene file
+/// (compared by file identity: device and inode, or the resolved path of a new file). Throws
+/// InputError.
+void check_outputs(const RenderExtras& e, const std::string& ckpt, const RenderOptions& ro,
+                   const std::string& scene) {
   if (!e.cost_image.empty() && ro.tracer == TracerKind::kEmbree)
     throw InputError("--cost-image " + e.cost_image +
                      ": --tracer embree counts no intersection tests (no cost image)");
@@ -106,13 +109,19 @@ void check_outputs(const RenderExtras& e, const std::string& ckpt, const RenderO
                             {"--level-image", e.level_image},
                             {"--stats", e.stats},
                             {"--checkpoint", ckpt}};
-  std::vector<std::pair<std::string, const char*>> files;  // resolved regular files
+  std::error_code ec;
+  const bool scene_file = scene.rfind("builtin:", 0) != 0 && std::filesystem::exists(scene, ec);
+  const std::string input = scene_file ? file_identity(scene) : std::string();
+  std::vector<std::pair<std::string, const char*>> files;  // regular files, by identity
   for (const Output& o : outputs) {
     if (o.path.empty()) continue;
     check_writable(o.path);
     const OutputTarget t = resolve_output(o.path);
     if (t.kind != OutputTarget::Kind::kFile) continue;  // devices and "-" may be shared
-    const std::string key = std::filesystem::weakly_canonical(t.path).string();
+    const std::string key = file_identity(o.path);
+    if (key == input)
+      throw InputError(std::string(o.option) + " " + o.path + ": the scene " + scene +
+                       " itself (an output never replaces an input)");
     for (const auto& [other, option] : files)
       if (other == key)
         throw InputError(std::string(o.option) + " " + o.path + ": the same file as " + option);
@@ -228,7 +237,7 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
   try {
     common.finish();
     if (!extra.cost_range.empty()) given_range = parse_cost_range(extra.cost_range);
-    if (root) check_outputs(extra, ckpt, o);  // the outputs are rank 0's
+    if (root) check_outputs(extra, ckpt, o, common.scene);  // the outputs are rank 0's
     const std::uint64_t asked =
         extra.max_memory.empty() ? 0 : parse_bytes(extra.max_memory, "--max-memory");
     if (!extra.max_memory.empty() && asked == 0)

@@ -45,11 +45,13 @@ struct CliResult {
   double seconds;
 };
 
-CliResult amalgam(const std::string& args) {
+/// Runs amalgam with `args` (in directory `cwd` if not empty); its status and stderr.
+CliResult amalgam(const std::string& args, const std::string& cwd = {}) {
   const std::string err =
       fs::temp_directory_path() / ("amalgam-rel-err-" + std::to_string(getpid()));
   const auto t0 = std::chrono::steady_clock::now();
-  const int st = std::system((std::string(AMALGAM_BINARY) + " " + args + " 2>" + err).c_str());
+  const std::string cd = cwd.empty() ? std::string() : "cd '" + cwd + "' && ";
+  const int st = std::system((cd + std::string(AMALGAM_BINARY) + " " + args + " 2>" + err).c_str());
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   CliResult r{WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st), slurp(err), s};
   fs::remove(err);
@@ -143,6 +145,61 @@ TEST(Outputs, TwoOutputsOnOneFileAreRefused) {
     EXPECT_LT(r.seconds, 5.0) << other;
   }
   EXPECT_FALSE(fs::exists(x));
+}
+
+// Two spellings of one file in the current directory: a bare name, ./name, $PWD/name.
+TEST(Outputs, TwoOutputsOnOneFileAreRefusedHoweverSpelled) {
+  Dir d("spelled");
+  for (const std::string& other :
+       {std::string("--cost-image ./x.png"), "--stats " + (d / "x.png"),
+        std::string("--stats sub/../x.png"), std::string("--checkpoint ./x.png")}) {
+    fs::create_directories(d.path / "sub");
+    const CliResult r = amalgam(kLong + " --out x.png " + other, d.path.string());
+    EXPECT_EQ(r.status, 2) << other << ": " << r.err;
+    EXPECT_NE(r.err.find("the same file as --out"), std::string::npos) << other << ": " << r.err;
+    EXPECT_LT(r.seconds, 5.0) << other;
+  }
+  EXPECT_FALSE(fs::exists(d / "x.png"));
+}
+
+// An output never replaces an input: the scene file (a .json or a mesh) or an image compared.
+TEST(Outputs, AnOutputOnAnInputIsRefusedAndTheInputKept) {
+  Dir d("input");
+  const std::string scene = d / "s.json", mesh = d / "m.obj";
+  fs::copy_file(std::string(AMALGAM_SOURCE_DIR) + "/scenes/spheres.json", scene);
+  { std::ofstream(mesh) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"; }
+  const std::string scene_bytes = slurp(scene), mesh_bytes = slurp(mesh);
+  fs::create_symlink(scene, d / "link.json");
+  const std::string small = " --width 8 --height 8 --spp 1 --quiet";
+  for (const std::string& args :
+       {"render " + scene + small + " --out " + (d / "x.png") + " --stats " + scene,
+        "render " + scene + small + " --out " + (d / "x.png") + " --checkpoint " + scene,
+        "render " + scene + small + " --out " + (d / "x.png") + " --stats " + (d / "link.json"),
+        "render " + mesh + small + " --out " + (d / "x.png") + " --stats " + mesh}) {
+    const CliResult r = amalgam(args);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.err;
+    EXPECT_NE(r.err.find("an output never replaces an input"), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(slurp(scene), scene_bytes);
+  EXPECT_EQ(slurp(mesh), mesh_bytes);
+  EXPECT_FALSE(fs::exists(d / "x.png"));
+
+  const std::string a = d / "a.pfm", b = d / "b.pfm";
+  ASSERT_EQ(amalgam("render builtin:prisms --set depth=3 --width 8 --height 8 --spp 1 --quiet "
+                    "--out " +
+                    a)
+                .status,
+            0);
+  fs::copy_file(a, b);
+  const std::string a_bytes = slurp(a);
+  for (const std::string& e : {a, d / "./b.pfm"}) {
+    const CliResult r = amalgam("compare " + a + " " + b + " --error-image " + e);
+    EXPECT_EQ(r.status, 2) << e << ": " << r.err;
+    EXPECT_NE(r.err.find("an output never replaces an input"), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(slurp(a), a_bytes);
+  EXPECT_EQ(slurp(b), a_bytes);
+  EXPECT_EQ(amalgam("compare " + a + " " + b + " --error-image " + (d / "e.png")).status, 0);
 }
 
 TEST(Numbers, OutOfRangeIsRefusedWithTheRangeNotClamped) {

@@ -76,6 +76,18 @@ OutputTarget resolve_output(const std::string& path) {
   return t;
 }
 
+std::string file_identity(const std::string& path) {
+  if (path == "-" || path.empty()) return {};
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0)
+    return "inode " + std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+  const OutputTarget t = resolve_output(path);  // links followed; its directory exists
+  const fs::path p(t.path);
+  std::error_code ec;
+  const fs::path dir = fs::canonical(p.parent_path().empty() ? fs::path(".") : p.parent_path(), ec);
+  return "path " + (ec ? fs::absolute(p).lexically_normal() : dir / p.filename()).string();
+}
+
 void check_writable(const std::string& path) {
   const OutputTarget t = resolve_output(path);
   if (t.kind == OutputTarget::Kind::kStdout) return;

@@ -39,6 +39,11 @@ struct OutputTarget {
 /// a directory, a symbolic link loop.
 OutputTarget resolve_output(const std::string& path);
 
+/// A key equal for two paths that name the same file, however spelled (`x.png`, `./x.png`,
+/// `$PWD/x.png`, `sub/../x.png`, a symbolic link to it): "inode DEV:INO" where the file exists,
+/// else "path P" with P the resolved directory and the name (links followed). Empty for "-".
+std::string file_identity(const std::string& path);
+
 /// Checks before any work that `path` can be written: resolve_output, then write permission
 /// on the file (or, for a new path, its directory). Throws InputError naming the path.
 void check_writable(const std::string& path);
