@@ -50,28 +50,11 @@
 #include "amalgam/io/image.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
+#include "bias_meadow.h"
 
 namespace amalgam {
 namespace {
 
-// The ASan/UBSan preset runs this file too, about 10x slower: there only the top row of tiles
-// (the far grass, where the amalgams are) is rendered. render_tile gives those pixels the
-// bytes of the whole-frame render, so the same per-tile figures are checked.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
-
-const std::string kScene = std::string(AMALGAM_SOURCE_DIR) + "/tests/data/bias-meadow.json";
-const std::string kReference = std::string(AMALGAM_SOURCE_DIR) + "/tests/data/bias-meadow-ref.pfm";
-constexpr int kWidth = 128, kHeight = 96, kTile = 32;
 constexpr double kTolerance = 0.03;  // issue 13's bias target, per tile and for the frame
 
 /// The 32 x 32 tiles checked: all 12, or under a sanitizer the top row.

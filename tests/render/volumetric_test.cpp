@@ -19,25 +19,10 @@
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
 #include "amalgam/traverse/cone_march.h"
+#include "bias_meadow.h"
 
 namespace amalgam {
 namespace {
-
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
-
-const std::string kScene = std::string(AMALGAM_SOURCE_DIR) + "/tests/data/bias-meadow.json";
-const std::string kReference = std::string(AMALGAM_SOURCE_DIR) + "/tests/data/bias-meadow-ref.pfm";
-constexpr int kWidth = 128, kHeight = 96, kTile = 32;
 
 LoadedScene load_objects(const std::string& path, bool correlated = true) {
   SceneFileConfig c;
