@@ -132,7 +132,8 @@ std::shared_ptr<RenderResult> make_result(const LoadedScene& scene, const Render
   return res;
 }
 
-/// A view keyword (eye=, look_at=, up=) as a Vec3; the CLI's message otherwise.
+/// A view keyword (eye=, look_at=, up=) as a Vec3; the CLI's message otherwise, naming the
+/// keyword (`option` is the CLI's flag).
 Vec3 view_vec(const py::handle& v, const std::string& option) {
   std::vector<float> x;
   try {
@@ -141,7 +142,8 @@ Vec3 view_vec(const py::handle& v, const std::string& option) {
   }
   const std::string text = py::str(v).cast<std::string>();
   if (x.size() != 3 || !is_finite(Vec3{x[0], x[1], x[2]}))
-    throw InputError(option + " '" + text + "': expected three numbers x,y,z");
+    throw InputError(option_text(option, OptionSpelling::kKeywords, "'" + text + "'") +
+                     ": expected three numbers x,y,z");
   return {x[0], x[1], x[2]};
 }
 
@@ -161,7 +163,8 @@ bool view_keyword(const std::string& key, const py::handle& value, CameraChoice&
     try {
       n = value.cast<int>();
     } catch (const py::cast_error&) {
-      throw InputError("--light-samples " + one_line(py::str(value).cast<std::string>(), 40) +
+      throw InputError(option_text("--light-samples", OptionSpelling::kKeywords,
+                                   one_line(py::str(value).cast<std::string>(), 40)) +
                        ": expected an integer in [1, 4096]");
     }
     view.light_samples = n;
@@ -173,7 +176,7 @@ bool view_keyword(const std::string& key, const py::handle& value, CameraChoice&
     } catch (const py::cast_error&) {
     }
     if (!(x > 0.0 && x < 180.0))
-      throw InputError("--fov " + one_line(text, 40) +
+      throw InputError(option_text("--fov", OptionSpelling::kKeywords, one_line(text, 40)) +
                        ": expected a vertical field of view in degrees, > 0 and < 180");
     view.fov_deg = static_cast<float>(x);
   } else {
