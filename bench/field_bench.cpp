@@ -53,8 +53,8 @@
 #include "amalgam/analysis/metrics.h"
 #include "amalgam/io/image.h"
 #include "amalgam/load/load_scene.h"
-#include "amalgam/render/embree_tracer.h"
 #include "amalgam/render/render.h"
+#include "amalgam/render/tracer.h"
 
 namespace amalgam {
 namespace {
@@ -102,7 +102,7 @@ std::string field_json(long count, int subdivide, const View& view) {
 
 struct Field {
   LoadedScene scene;
-  std::unique_ptr<EmbreeScene> embree;
+  std::unique_ptr<Tracer> embree;  ///< --tracer embree
   double triangles = 0;
   double our_build_s = 0;
 };
@@ -118,7 +118,10 @@ std::unique_ptr<Field> make_field(long count, int subdivide, const View& view) {
   f->scene.hierarchy = build_hierarchy(std::move(d));
   f->our_build_s = seconds_since(t0);
   f->triangles = f->scene.info().primitives;
-  f->embree = std::make_unique<EmbreeScene>(f->scene);
+  RenderOptions oe;
+  oe.lod = FullDetail{};
+  oe.tracer = TracerKind::kEmbree;
+  f->embree = make_tracer(f->scene, oe);
   return f;
 }
 
@@ -148,7 +151,7 @@ Shot ours(const Field& f, const RenderOptions& o) {
 Shot embree(const Field& f, const RenderOptions& o) {
   RenderOptions oe = o;
   oe.tracer = TracerKind::kEmbree;
-  RenderOutput r = render_embree(*f.embree, oe);
+  RenderOutput r = f.embree->render(oe);
   return {std::move(r.image), r.seconds, 0.0};
 }
 

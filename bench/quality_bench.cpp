@@ -12,7 +12,7 @@
 //   camera), the image size and these settings: reruns are cheap.
 // - Renderers, all with stratified pixel sampling: amalgam traditional; Intel Embree 3 at full
 //   detail in its default configuration (RTC_BUILD_QUALITY_MEDIUM, no scene flags, the same
-//   pass loop, sampling and shading: embree_field.h); amalgam scale-sensitive (stochastic
+//   pass loop, sampling and shading: make_tracer); amalgam scale-sensitive (stochastic
 //   opacity) at each footprint K of --footprints. Each at each spp of --spps, --runs times
 //   with different seeds.
 // - Time to image: everything from the scene file to the finished image, per run. amalgam:
@@ -47,8 +47,9 @@
 #include "amalgam/analysis/metrics.h"
 #include "amalgam/io/image.h"
 #include "amalgam/load/load_scene.h"
+#include "amalgam/render/passes.h"
+#include "amalgam/render/tracer.h"
 #include "amalgam/util/atomic_file.h"
-#include "embree_field.h"
 #include "oracle.h"
 
 namespace amalgam {
@@ -252,10 +253,15 @@ Run run_once(const Args& a, const std::string& kind, float k, int spp, std::uint
   }
   Run r;
   if (kind == "embree") {
-    const auto& h = std::get<InstancedHierarchy>(s.hierarchy);
-    EmbreeField f(h);  // Embree's defaults: RTC_BUILD_QUALITY_MEDIUM, RTC_SCENE_FLAG_NONE
-    r.image = embree_render(h, s.env, f, o, &r.render);
-    r.fixed = s.load_seconds + f.build_seconds;
+    o.lod = FullDetail{};
+    o.tracer = TracerKind::kEmbree;
+    // Embree's default configuration: RTC_BUILD_QUALITY_MEDIUM, RTC_SCENE_FLAG_NONE.
+    const std::unique_ptr<Tracer> embree =
+        make_tracer(s, o, {EmbreeBuild::Quality::kMedium, /*robust=*/false});
+    RenderOutput out = embree->render(o);
+    r.image = std::move(out.image);
+    r.render = out.seconds;
+    r.fixed = s.load_seconds + embree->build_seconds();
     return r;
   }
   if (kind == "traditional") o.lod = FullDetail{};

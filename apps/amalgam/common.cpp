@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "amalgam/render/option_rules.h"
+#include "amalgam/render/tracer.h"
 
 namespace amalgam::cli {
 
@@ -86,12 +87,7 @@ void CommonOptions::finish() {
   r.width = options.width, r.height = options.height, r.spp = options.spp;
   r.threads = threads;
   r.seed = parse_seed(seed);
-#if !defined(AMALGAM_HAVE_EMBREE)
-  if (tracer == "embree")
-    throw InputError(
-        "--tracer embree: this amalgam was built without Embree (install libembree-dev, "
-        "reconfigure with -DAMALGAM_EMBREE=ON)");
-#endif
+  if (tracer == "embree") require_tracer(TracerKind::kEmbree);  // before its other refusals
   options = resolve_options(r, OptionSpelling::kFlags);
   view = CameraChoice{};
   view.camera = camera;

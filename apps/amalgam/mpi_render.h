@@ -47,7 +47,7 @@ int agree(std::exception_ptr failure);
 /// Rank 0 sends `text` to every rank; returns rank 0's text on every rank.
 std::string broadcast(const std::string& text);
 
-/// Renders samples s0 .. s1 - 1 into a tile (render_tile or render_tile_embree); false when
+/// Renders samples s0 .. s1 - 1 into a tile (Tracer::render_tile, render/tracer.h); false when
 /// `cancel` stopped it.
 using TileRenderer =
     std::function<bool(FilmTile& tile, int s0, int s1, const std::atomic<bool>* cancel)>;

@@ -22,9 +22,7 @@
 #include "amalgam/io/stats_json.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
-#if defined(AMALGAM_HAVE_EMBREE)
-#include "amalgam/render/embree_tracer.h"
-#endif
+#include "amalgam/render/tracer.h"
 #include "amalgam/util/atomic_file.h"
 #include "amalgam/util/version.h"
 #include "common.h"
@@ -227,10 +225,7 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
   std::optional<LoadedScene> loaded;
   std::string fp;
   FilmState state;
-  bool embree = false;
-#if defined(AMALGAM_HAVE_EMBREE)
-  std::unique_ptr<EmbreeScene> embree_scene;
-#endif
+  std::unique_ptr<Tracer> tracer;
   // In a parallel render every rank prepares (options, scene) before any renders, and a rank
   // that fails tells the others (mpi::agree) rather than leaving them waiting.
   std::exception_ptr failure;
@@ -261,15 +256,11 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
     };
     loaded.emplace(load_scene(common.scene, common.params(), budget));
     common.prepare(*loaded);  // the view options, before the fingerprint takes the camera
-    check_options(*loaded, o);
-    embree = o.tracer == TracerKind::kEmbree;
-#if defined(AMALGAM_HAVE_EMBREE)
-    if (embree) {
+    if (o.tracer == TracerKind::kEmbree) {
       set_activity("building Embree's BVH of " + common.scene);
       status.phase(activity());
-      embree_scene = std::make_unique<EmbreeScene>(*loaded, o.threads);
     }
-#endif
+    tracer = make_tracer(*loaded, o);  // checks the options against the scene first
     status.stop();
     if (root) print_warnings(*loaded);  // after the load phases' status line
 
@@ -310,10 +301,7 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
   // What renders a tile on this rank: amalgam's traversal or Embree, as for one process.
   const mpi::TileRenderer tile_renderer = [&](FilmTile& t, int s0, int s1,
                                               const std::atomic<bool>* cancel) {
-#if defined(AMALGAM_HAVE_EMBREE)
-    if (embree) return render_tile_embree(*embree_scene, o, t, s0, s1, cancel);
-#endif
-    return render_tile(scene, o, t, s0, s1, cancel);
+    return tracer->render_tile(o, t, s0, s1, cancel);
   };
   if (!root) {
     mpi::serve(tile_renderer, o, g_cancel, g_signal);
@@ -351,13 +339,8 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
                          extra.checkpoint_every, stop);
   }
 #endif
-  double embree_build = 0.0;
-#if defined(AMALGAM_HAVE_EMBREE)
-  if (embree && !parallel) r = render_embree(*embree_scene, o, &state, control);
-  if (embree) embree_build = embree_scene->build_seconds();
-#endif
-  // (finish() refused --tracer embree in a build without Embree.)
-  if (!embree && !parallel) r = render(scene, o, &state, control);
+  if (!parallel) r = tracer->render(o, &state, control);
+  const double embree_build = tracer->build_seconds();
   progress.finish();
   set_activity("writing the outputs of " + common.scene);
   // The work is done: writing its results wins over further signals (on_signal).
@@ -390,7 +373,7 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
              {"amalgam:level", "level.Y: level of the rendered amalgams (majority of samples); " +
                                    std::to_string(kLevelPrimitive) + ": primitives; " +
                                    std::to_string(kLevelNothing) + ": nothing hit"}},
-            !embree);
+            tracer->counts_tests());
         if (top > 16777216.0)
           std::cerr << "amalgam: warning: " << extra.out << ": a pixel holds " << top
                     << " tests, beyond 2^24: its cost.Y is rounded to float32 (the stats JSON "
@@ -445,7 +428,7 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
   if (!extra.quiet) {
     std::cerr << "amalgam: wrote " << extra.out << " (" << r.width << "x" << r.height << ", "
               << r.spp << " spp, " << r.seconds << " s, ";
-    if (embree)
+    if (!tracer->counts_tests())
       std::cerr << "Embree, BVH build " << embree_build << " s)\n";
     else
       std::cerr << r.per_primary.mean() << " tests per primary ray)\n";
@@ -478,22 +461,10 @@ int run_trace(CommonOptions& common, const std::string& origin, const std::strin
     ray = Ray::make(o, normalize(d));
     ray.cone_spread = spread;
   }
-  const bool embree = common.options.tracer == TracerKind::kEmbree;
-  double embree_build = 0.0;
-#if defined(AMALGAM_HAVE_EMBREE)
-  std::unique_ptr<EmbreeScene> embree_scene;
-  if (embree) {
-    embree_scene = std::make_unique<EmbreeScene>(scene, common.options.threads);
-    embree_build = embree_scene->build_seconds();
-  }
-#endif
+  const std::unique_ptr<Tracer> tracer = make_tracer(scene, common.options);
+  const double embree_build = tracer->build_seconds();
   const auto t0 = std::chrono::steady_clock::now();
-#if defined(AMALGAM_HAVE_EMBREE)
-  const TraceOutput t =
-      embree ? trace_embree(*embree_scene, common.options, ray) : trace(scene, common.options, ray);
-#else
-  const TraceOutput t = trace(scene, common.options, ray);  // finish() refused --tracer embree
-#endif
+  const TraceOutput t = tracer->trace(common.options, ray);
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const nlohmann::json j = trace_json(scene, common.options, t, secs, embree_build);
   std::cout << j.dump(2) << "\n";

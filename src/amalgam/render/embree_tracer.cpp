@@ -145,9 +145,8 @@ void on_embree_error(void* user, RTCError code, const char* message) {
                (message ? message : "(no message)");
 }
 
-}  // namespace
-
-struct EmbreeScene::Impl {
+/// Embree's device and BVHs of one loaded scene.
+struct EmbreeBvh {
   const LoadedScene* loaded = nullptr;
   DeviceErrors errors;
   RTCDevice device = nullptr;
@@ -155,7 +154,7 @@ struct EmbreeScene::Impl {
   RTCScene top = nullptr;          ///< the scene rays are traced in
   double build_seconds = 0.0;
 
-  ~Impl() {
+  ~EmbreeBvh() {
     if (top && (meshes.empty() || top != meshes.front().scene)) rtcReleaseScene(top);
     for (EmbreeMesh& m : meshes)
       if (m.scene) rtcReleaseScene(m.scene);
@@ -167,12 +166,15 @@ struct EmbreeScene::Impl {
       throw RuntimeError(std::string("embree: ") + what + ": " + errors.first);
   }
 
-  static RTCScene new_scene(RTCDevice device) {
+  EmbreeBuild build_options;
+
+  RTCScene new_scene() const {
     RTCScene s = rtcNewScene(device);
-    // Robust: no traversal shortcut that could lose a hit through an edge (our own tests are
-    // watertight); high quality: the best BVH Embree builds for a static scene.
-    rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
+    rtcSetSceneFlags(s, build_options.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
+    rtcSetSceneBuildQuality(
+        s, build_options.quality == EmbreeBuild::Quality::kHigh     ? RTC_BUILD_QUALITY_HIGH
+           : build_options.quality == EmbreeBuild::Quality::kMedium ? RTC_BUILD_QUALITY_MEDIUM
+                                                                    : RTC_BUILD_QUALITY_LOW);
     return s;
   }
 
@@ -192,7 +194,7 @@ struct EmbreeScene::Impl {
         m.user->bounds.push_back(bounds(p));
       }
     });
-    m.scene = new_scene(device);
+    m.scene = new_scene();
     const std::size_t tris = m.ids[kTriangles].size();
     if (tris > 0) {
       RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -239,10 +241,10 @@ struct EmbreeScene::Impl {
   /// An implicit builtin: its primitives, listed by walking the hierarchy once.
   template <class H>
   void build(const H& h) {
-    if (h.info().primitives > kMaxListedPrimitives)
+    if (h.info().primitives > kMaxEmbreeListedPrimitives)
       throw InputError(loaded->name + ": " + std::to_string(h.info().primitives) +
                        " primitives, more than --tracer embree lists (" +
-                       std::to_string(static_cast<long long>(kMaxListedPrimitives)) + ")");
+                       std::to_string(static_cast<long long>(kMaxEmbreeListedPrimitives)) + ")");
     add_mesh(h, [&](auto&& f) {
       std::vector<NodeId> stack{h.root()};
       while (!stack.empty()) {
@@ -266,7 +268,7 @@ struct EmbreeScene::Impl {
         for (std::size_t i = 0; i < mesh.prims.size(); ++i) f(i, mesh.prims[i]);
       });
     }
-    top = new_scene(device);
+    top = new_scene();
     for (std::size_t i = 0; i < h.instances.size(); ++i) {
       const InstancedHierarchy::InstanceData& in = h.instances[i];
       RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
@@ -281,35 +283,12 @@ struct EmbreeScene::Impl {
   }
 };
 
-EmbreeScene::EmbreeScene(const LoadedScene& scene, int threads) : impl_(std::make_unique<Impl>()) {
-  const auto t0 = Clock::now();
-  impl_->loaded = &scene;
-  const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
-  impl_->device = rtcNewDevice(config.c_str());
-  if (!impl_->device)
-    throw RuntimeError("embree: no device (error " +
-                       std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")");
-  rtcSetDeviceErrorFunction(impl_->device, on_embree_error, &impl_->errors);
-  std::visit([&](const auto& h) { impl_->build(h); }, scene.hierarchy);
-  impl_->build_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-EmbreeScene::~EmbreeScene() = default;
-double EmbreeScene::build_seconds() const {
-  return impl_->build_seconds;
-}
-const LoadedScene& EmbreeScene::scene() const {
-  return *impl_->loaded;
-}
-
-namespace {
-
 /// The Integrator's tracer over Embree (full detail: every primitive opaque, no amalgams).
 /// Counts rays (as amalgam's traversal does), no tests.
 template <class H>
-class EmbreeTracer {
+class EmbreeHits {
  public:
-  EmbreeTracer(const H& h, const EmbreeScene::Impl& s, Counters& c) : h_(&h), s_(&s), c_(&c) {}
+  EmbreeHits(const H& h, const EmbreeBvh& s, Counters& c) : h_(&h), s_(&s), c_(&c) {}
 
   TraceHit intersect(const Ray& ray, std::uint64_t, std::vector<TranslucentHit>*) {
     c_->count_ray(RayKind::kPrimary);
@@ -381,74 +360,103 @@ class EmbreeTracer {
   }
 
   const H* h_;
-  const EmbreeScene::Impl* s_;
+  const EmbreeBvh* s_;
   Counters* c_;
 };
 
 template <class H>
 using EmbreeIntegrator =
-    Integrator<H, TraditionalLod, StochasticOpacity, SortedOrder, Counters, EmbreeTracer<H>>;
+    Integrator<H, TraditionalLod, StochasticOpacity, SortedOrder, Counters, EmbreeHits<H>>;
 
-void check_embree(const EmbreeScene& s, const RenderOptions& o) {
-  check_options(s.scene(), o);
-  if (o.tracer != TracerKind::kEmbree)
-    throw InputError("render_embree: expected options with --tracer embree");
-}
+/// The Tracer over Embree's BVHs of one scene.
+class EmbreeTracer final : public Tracer {
+ public:
+  EmbreeTracer(const LoadedScene& scene, int threads, const EmbreeBuild& build) {
+    const auto t0 = Clock::now();
+    bvh_.loaded = &scene;
+    bvh_.build_options = build;
+    const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
+    bvh_.device = rtcNewDevice(config.c_str());
+    if (!bvh_.device)
+      throw RuntimeError("embree: no device (error " +
+                         std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")");
+    rtcSetDeviceErrorFunction(bvh_.device, on_embree_error, &bvh_.errors);
+    std::visit([&](const auto& h) { bvh_.build(h); }, scene.hierarchy);
+    bvh_.build_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+
+  RenderOutput render(const RenderOptions& o, FilmState* resume,
+                      const RenderControl& control) const override {
+    check(o);
+    const LoadedScene& scene = *bvh_.loaded;
+    const auto t0 = Clock::now();
+    FilmState local;
+    FilmState& st = resume ? *resume : local;
+    start_film(st, o);
+    const bool interrupted = std::visit(
+        [&](const auto& h) {
+          using H = std::decay_t<decltype(h)>;
+          return render_passes(scene.env.camera, o, st, control, [&](Counters& c) {
+            return EmbreeIntegrator<H>(h, scene.env, EmbreeHits<H>(h, bvh_, c));
+          });
+        },
+        scene.hierarchy);
+    RenderOutput out = finish(st);
+    out.interrupted = interrupted;
+    out.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    return out;
+  }
+
+  bool render_tile(const RenderOptions& o, FilmTile& tile, int s0, int s1,
+                   const std::atomic<bool>* cancel) const override {
+    check(o);
+    const LoadedScene& scene = *bvh_.loaded;
+    const bool interrupted = std::visit(
+        [&](const auto& h) {
+          using H = std::decay_t<decltype(h)>;
+          return render_tile_passes(scene.env.camera, o, tile, s0, s1, cancel, [&](Counters& c) {
+            return EmbreeIntegrator<H>(h, scene.env, EmbreeHits<H>(h, bvh_, c));
+          });
+        },
+        scene.hierarchy);
+    return !interrupted;
+  }
+
+  TraceOutput trace(const RenderOptions& o, const Ray& ray) const override {
+    check(o);
+    const LoadedScene& scene = *bvh_.loaded;
+    TraceOutput out;
+    std::visit(
+        [&](const auto& h) {
+          using H = std::decay_t<decltype(h)>;
+          EmbreeIntegrator<H> integrator(h, scene.env, EmbreeHits<H>(h, bvh_, out.counters));
+          const SampleResult r = integrator.li(ray, hash_combine(hash_combine(o.seed, 0), 0));
+          out.hit = r.hit;
+          out.colour = r.colour;
+        },
+        scene.hierarchy);
+    out.per_primary.add(out.counters.total());
+    return out;
+  }
+
+  double build_seconds() const override { return bvh_.build_seconds; }
+  bool counts_tests() const override { return false; }
+
+ private:
+  void check(const RenderOptions& o) const {
+    check_options(*bvh_.loaded, o);
+    if (o.tracer != TracerKind::kEmbree)
+      throw InputError("the Embree tracer: expected options with --tracer embree");
+  }
+
+  EmbreeBvh bvh_;
+};
 
 }  // namespace
 
-RenderOutput render_embree(const EmbreeScene& es, const RenderOptions& o, FilmState* resume,
-                           const RenderControl& control) {
-  check_embree(es, o);
-  const LoadedScene& scene = es.scene();
-  const auto t0 = Clock::now();
-  FilmState local;
-  FilmState& st = resume ? *resume : local;
-  start_film(st, o);
-  const bool interrupted = std::visit(
-      [&](const auto& h) {
-        using H = std::decay_t<decltype(h)>;
-        return render_passes(scene.env.camera, o, st, control, [&](Counters& c) {
-          return EmbreeIntegrator<H>(h, scene.env, EmbreeTracer<H>(h, es.impl(), c));
-        });
-      },
-      scene.hierarchy);
-  RenderOutput out = finish(st);
-  out.interrupted = interrupted;
-  out.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  return out;
-}
-
-bool render_tile_embree(const EmbreeScene& es, const RenderOptions& o, FilmTile& tile, int s0,
-                        int s1, const std::atomic<bool>* cancel) {
-  check_embree(es, o);
-  const LoadedScene& scene = es.scene();
-  const bool interrupted = std::visit(
-      [&](const auto& h) {
-        using H = std::decay_t<decltype(h)>;
-        return render_tile_passes(scene.env.camera, o, tile, s0, s1, cancel, [&](Counters& c) {
-          return EmbreeIntegrator<H>(h, scene.env, EmbreeTracer<H>(h, es.impl(), c));
-        });
-      },
-      scene.hierarchy);
-  return !interrupted;
-}
-
-TraceOutput trace_embree(const EmbreeScene& es, const RenderOptions& o, const Ray& ray) {
-  check_embree(es, o);
-  const LoadedScene& scene = es.scene();
-  TraceOutput out;
-  std::visit(
-      [&](const auto& h) {
-        using H = std::decay_t<decltype(h)>;
-        EmbreeIntegrator<H> integrator(h, scene.env, EmbreeTracer<H>(h, es.impl(), out.counters));
-        const SampleResult r = integrator.li(ray, hash_combine(hash_combine(o.seed, 0), 0));
-        out.hit = r.hit;
-        out.colour = r.colour;
-      },
-      scene.hierarchy);
-  out.per_primary.add(out.counters.total());
-  return out;
+std::unique_ptr<Tracer> make_embree_tracer(const LoadedScene& scene, int threads,
+                                           const EmbreeBuild& build) {
+  return std::make_unique<EmbreeTracer>(scene, threads, build);
 }
 
 }  // namespace amalgam

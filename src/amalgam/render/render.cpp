@@ -45,7 +45,7 @@ void check_options(const LoadedScene& scene, const RenderOptions& o, OptionSpell
 namespace {
 void require_amalgam_tracer(const RenderOptions& o) {
   if (o.tracer != TracerKind::kAmalgam)
-    throw InputError("--tracer embree: render with render_embree (render/embree_tracer.h)");
+    throw InputError("--tracer embree: render with make_tracer (render/tracer.h)");
 }
 }  // namespace
 

@@ -95,7 +95,7 @@ struct RenderControl {
 };
 
 /// Renders the scene's camera view progressively with amalgam's traversal (options.tracer must
-/// be kAmalgam; Embree renders go through render_embree, render/embree_tracer.h), in passes of
+/// be kAmalgam; Embree renders go through make_tracer, render/tracer.h), in passes of
 /// whole samples per pixel. Pixel (x, y), sample s uses the random stream hash(seed, y * width + x,
 /// s), and each pixel's samples are summed in sample order: the output is identical for any thread
 /// count, and a render resumed from a FilmState equals the uninterrupted one bit for bit. `resume`
@@ -121,7 +121,7 @@ bool render_tile(const LoadedScene& scene, const RenderOptions& options, FilmTil
 int samples_per_pass(std::size_t pixels);
 
 /// Prepares `st` for a render of `options`: a fresh film when it holds none, else checks that
-/// the saved one fits (InputError). Shared by `render` and `render_embree`.
+/// the saved one fits (InputError). Shared by `render` and the Embree tracer.
 void start_film(FilmState& st, const RenderOptions& options);
 
 /// Converts accumulated state into an output (mean over the samples it holds).
