@@ -41,9 +41,9 @@ struct Counters {
   /// same counts as n calls of count_test, in two additions.
   void count_tests(RayKind r, ObjectKind o, int level, std::uint64_t n) {
     tests[static_cast<int>(r)][static_cast<int>(o)] += n;
-    // A branch, not a minimum: in the counted walk GCC kept the level in a vector register
-    // and took the minimum with a 16-byte load of the slot it had just stored 4 bytes of, a
-    // failed store forwarding at every node (docs/benchmarks.md, thirteenth round).
+    // A branch, not a minimum: with a minimum GCC kept the level in a vector register and
+    // took it with a 16-byte load of the slot it had just stored 4 bytes of (a failed store
+    // forwarding at every node of a counted walk).
     if (static_cast<unsigned>(level) < kCountedLevels) [[likely]]
       by_level[static_cast<unsigned>(level)] += n;
     else

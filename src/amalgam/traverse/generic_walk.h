@@ -14,7 +14,7 @@ struct GenericWalk {
   /// read when the LOD policy may render).
   static void enter(State& s, NodeId id, int level, const Bbox& b, float t_entry) {
     if (t_entry > s.ray.tmax) return;  // a closer hit was found since this node was tested
-    s.counters.count_reached(s.kind);
+    s.count_reached();
     if constexpr (State::kMayRender) {
       if (s.renders(id, b, level, t_entry)) {
         s.render_amalgam(id, level, b, t_entry);
@@ -37,12 +37,12 @@ struct GenericWalk {
     int n = 0;
     s.h.for_each_child(node, [&](Child ch) {
       if (ch.is_primitive) {
-        s.counters.count_test(s.kind, ObjectKind::kPrimitive, cl);
+        s.count_primitives(cl);
         if (auto hit = s.h.intersect(ch.id, s.ray)) s.on_primitive(ch.id, cl, *hit);
         return !s.done;
       }
       const Bbox b = s.h.bounds(ch.id);
-      s.counters.count_test(s.kind, s.object_kind(cl), cl);
+      s.count_children(cl, 1);
       float t0, t1;
       if (!intersect_box(s.ray, b, t0, t1)) return true;
       if constexpr (kSorted) {

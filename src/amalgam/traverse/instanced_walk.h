@@ -83,7 +83,7 @@ class InstancedWalk {
     std::size_t cap = stack_.size(), sp = 0;
     StackItem it{t_root, top.root, 0, 0};
     for (;;) {
-      s.counters.count_reached(s.kind);
+      s.count_reached();
       Next next;
       if (s.render_if_policy([&] { return node_id(s, top, it); }, it.level, it.t))
         next = s.done ? Next::kStop : Next::kPop;
@@ -109,7 +109,7 @@ class InstancedWalk {
     const WideRecord rec = top.record(it.ref);
     const int count = top.child_count(it.ref);
     const int cl = it.level + 1;
-    s.counters.count_tests(s.kind, s.object_kind(cl), cl, static_cast<std::uint64_t>(count));
+    s.count_children(cl, count);
     const bool instances = it.ref & kWideRefLeaf;
     return children(
         it, st, cap, sp, count,
@@ -143,7 +143,7 @@ class InstancedWalk {
         return s.done ? Next::kStop : Next::kPop;
       }
       for (int i = 0; i < hd.count; ++i) {  // spheres or boxes: the generic path's test
-        s.counters.count_test(s.kind, ObjectKind::kPrimitive, cl);
+        s.count_primitives(cl);
         const PrimId id = IH::id(inst, hd.first + static_cast<std::uint32_t>(i));
         if (auto hit = s.h.intersect(id, s.ray)) s.on_primitive(id, cl, *hit);
         if (s.done) return Next::kStop;
@@ -152,7 +152,7 @@ class InstancedWalk {
     }
     const WideRecord rec = w.record(it.ref);
     const int count = w.child_count(it.ref);
-    s.counters.count_tests(s.kind, s.object_kind(cl), cl, static_cast<std::uint64_t>(count));
+    s.count_children(cl, count);
     auto child = [&](int c) { return StackItem{0, nth(rec, c).child(c % kBoxLanes), inst, cl}; };
     if (in.identity) {
       return children(

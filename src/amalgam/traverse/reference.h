@@ -43,13 +43,13 @@ class ReferenceTraversal {
   void run() {
     const NodeId root = s_.h.root();
     const Bbox b = s_.h.bounds(root);
-    s_.counters.count_test(s_.kind, s_.object_kind(0), 0);
+    s_.count_root();
     if (auto span = intersect_box(s_.ray, b)) enter(root, 0, b, span->t0);
   }
 
   void enter(NodeId id, int level, const Bbox& b, float t_entry) {
     if (t_entry > s_.ray.tmax) return;  // a closer hit was found since this node was tested
-    s_.counters.count_reached(s_.kind);
+    s_.count_reached();
     if (s_.renders(id, b, level, t_entry))
       s_.render_amalgam(id, level, b, t_entry);
     else
@@ -67,12 +67,12 @@ class ReferenceTraversal {
     int n = 0;
     s_.h.for_each_child(node, [&](Child ch) {
       if (ch.is_primitive) {
-        s_.counters.count_test(s_.kind, ObjectKind::kPrimitive, cl);
+        s_.count_primitives(cl);
         if (auto hit = s_.h.intersect(ch.id, s_.ray)) s_.on_primitive(ch.id, cl, *hit);
         return !s_.done;
       }
       const Bbox b = s_.h.bounds(ch.id);
-      s_.counters.count_test(s_.kind, s_.object_kind(cl), cl);
+      s_.count_children(cl, 1);
       const auto span = intersect_box(s_.ray, b);
       if (!span) return true;
       if constexpr (Order::kSorted) {

@@ -88,6 +88,29 @@ struct RayState {
     return lod.may_render(level) ? ObjectKind::kAmalgam : ObjectKind::kBoundingVolume;
   }
 
+  // Cost accounting: the one place where a walk's events become counts (the paper's unit: one
+  // ray/object test, on the level of the object tested). Each walk calls these once per event.
+
+  /// The root's own box test (level 0), before the walk starts.
+  void count_root() { counters.count_test(kind, object_kind(0), 0); }
+  /// A node taken from the walk's order and then entered or rendered (Counters::reached).
+  void count_reached() { counters.count_reached(kind); }
+  /// `n` children of a node tested, on level `level`: amalgams where the LOD policy may render
+  /// there, else bounding volumes.
+  void count_children(int level, int n) {
+    counters.count_tests(kind, object_kind(level), level, static_cast<std::uint64_t>(n));
+  }
+  /// `n` primitives tested on `level`.
+  void count_primitives(int level, int n = 1) {
+    counters.count_tests(kind, ObjectKind::kPrimitive, level, static_cast<std::uint64_t>(n));
+  }
+  /// A pack of `m` primitives on `level` tested at once, with hits in the lanes `mask`: counted
+  /// as the one-by-one loop tests them -- all m, except that a shadow ray stops at its first hit
+  /// (lanes up to and including the lowest set one).
+  void count_pack(int level, int m, unsigned mask) {
+    count_primitives(level, any_hit && mask ? std::countr_zero(mask) + 1 : m);
+  }
+
   /// The LOD policy's answer for a node on `level` with box `b`, entered at `t`: render it
   /// (true) or descend. A node that contains the ray's origin (the ray starts inside it) is
   /// flagged to the policy as such.

@@ -77,7 +77,7 @@ class Traversal {
   void run() {
     const NodeId root = s_.h.root();
     const Bbox b = s_.h.bounds(root);
-    s_.counters.count_test(s_.kind, s_.object_kind(0), 0);
+    s_.count_root();
     float t0, t1;
     if (!intersect_box(s_.ray, b, t0, t1)) return;
     if constexpr (kWide) {

@@ -77,14 +77,11 @@ struct PackLeaf {
   template <class FirstOf, class Hits>
   [[gnu::always_inline]] static bool take(State& s, const FirstOf& first, int level, int c0, int m,
                                           unsigned mask, const Hits& c) {
+    s.count_pack(level, m, mask);
     if (s.any_hit && mask) {
-      const int tested = std::countr_zero(mask) + 1;
-      s.counters.count_tests(s.kind, ObjectKind::kPrimitive, level,
-                             static_cast<std::uint64_t>(tested));
       s.occlude();
       return false;
     }
-    s.counters.count_tests(s.kind, ObjectKind::kPrimitive, level, static_cast<std::uint64_t>(m));
     for (; mask; mask &= mask - 1) {
       const int lane = std::countr_zero(mask);
       if (!(c.t[lane] <= s.ray.tmax)) continue;  // an earlier lane hit closer
@@ -143,7 +140,7 @@ class WideWalk {
     std::size_t cap = stack_.size(), sp = 0;
     StackItem it = st[0];
     for (;;) {
-      s.counters.count_reached(s.kind);
+      s.count_reached();
       const Next next = !s.render_if_policy([&] { return w.node_of(it.ref); }, it.level, it.t)
                             ? expand<kRays>(s, arr, wr, it, st, cap, sp)
                         : s.done ? Next::kStop
@@ -192,7 +189,7 @@ class WideWalk {
         return s.done ? Next::kStop : Next::kPop;
       }
       for (int i = 0; i < hd.count; ++i) {
-        s.counters.count_test(s.kind, ObjectKind::kPrimitive, cl);
+        s.count_primitives(cl);
         primitive(s, wr.pre, hd.first + static_cast<std::uint32_t>(i), cl);
         if (s.done) return Next::kStop;
       }
@@ -202,7 +199,7 @@ class WideWalk {
     if (count > kBoxLanes) [[unlikely]]
       return many<kRays>(s, w, wr, it, st, cap, sp, cl);
     const WideRecord rec = WideRecord::at(w.pool, ref);
-    s.counters.count_tests(s.kind, s.object_kind(cl), cl, static_cast<std::uint64_t>(count));
+    s.count_children(cl, count);
     // One kernel call for the whole node: a single hit child is entered at once, without
     // touching the stack.
     alignas(32) float t[kBoxLanes];
@@ -247,7 +244,7 @@ class WideWalk {
   Next many(State& s, const Arrays& w, const WideRay& wr, StackItem& it, StackItem*& st,
             std::size_t& cap, std::size_t& sp, int cl) {
     const int count = w.nodes->child_count(it.ref);
-    s.counters.count_tests(s.kind, s.object_kind(cl), cl, static_cast<std::uint64_t>(count));
+    s.count_children(cl, count);
     reserve(st, cap, sp + static_cast<std::size_t>(count));
     const std::size_t base = sp;
     WideRecord rec = w.nodes->record(it.ref);
