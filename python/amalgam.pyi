@@ -6,6 +6,7 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+has_embree: bool  # whether tracer="embree" is available in this build
 
 class RenderResult:
     """The outputs of Scene.render. Pixel (x, y) is [y, x], row 0 at the top."""
@@ -56,6 +57,7 @@ class Scene:
         up: Optional[Sequence[float]] = None,
         fov: Optional[float] = None,
         light_samples: Optional[int] = None,
+        tracer: str = "amalgam",  # or "embree": full detail in Intel Embree 3
     ) -> RenderResult:
         """Renders the camera view (camera=, eye=, look_at=, up=, fov= change it for this
         render only, from the view `load` chose); KeyboardInterrupt carries `.partial`."""
@@ -72,6 +74,7 @@ class Scene:
         footprint: Optional[float] = None,
         order: str = "sorted",
         seed: int = 0,
+        tracer: str = "amalgam",  # or "embree"
     ) -> dict[str, Any]:
         """One primary ray with its shadow rays: 'hit', 'colour' and the counts."""
 

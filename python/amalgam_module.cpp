@@ -26,6 +26,7 @@
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/option_rules.h"
 #include "amalgam/render/render.h"
+#include "amalgam/render/tracer.h"
 #include "amalgam/util/error.h"
 #include "amalgam/util/version.h"
 
@@ -65,10 +66,17 @@ struct Options {
 Options make_options(int width, int height, int spp, const std::string& renderer,
                      const std::string& opacity, std::optional<int> level,
                      std::optional<float> footprint, const std::string& order, std::uint64_t seed,
-                     int threads, const std::string& sampler = "independent") {
-  // The CLI's checks (render/option_rules.h), its messages naming keywords.
+                     int threads, const std::string& sampler = "independent",
+                     const std::string& tracer = "amalgam") {
+  // The CLI's checks (render/option_rules.h), its messages naming keywords. A keyword left at
+  // its default counts as not given, as a flag left out does (tracer='embree' alone is then
+  // the traditional renderer in Embree, as `--tracer embree` is).
   OptionRequest q;
-  q.renderer = renderer, q.opacity = opacity, q.order = order, q.sampler = sampler;
+  auto given = [](const std::string& v, const char* def) {
+    return v == def ? std::nullopt : std::optional<std::string>(v);
+  };
+  q.renderer = given(renderer, "scale-sensitive"), q.opacity = given(opacity, "stochastic");
+  q.order = given(order, "sorted"), q.sampler = sampler, q.tracer = tracer;
   q.level = level;
   if (footprint) q.footprint = *footprint;
   q.width = width, q.height = height, q.spp = spp, q.threads = threads;
@@ -89,11 +97,11 @@ struct RenderResult {
 
 /// Converts a finished (or interrupted) render; needs the GIL.
 std::shared_ptr<RenderResult> make_result(const LoadedScene& scene, const RenderOptions& o,
-                                          RenderOutput&& r) {
+                                          RenderOutput&& r, double embree_build = 0.0) {
   auto res = std::make_shared<RenderResult>();
   const bool whole = r.image.size() == static_cast<std::size_t>(r.width) * r.height && r.spp > 0;
   const py::ssize_t h = whole ? r.height : 0, w = whole ? r.width : 0;
-  nlohmann::json j = stats_json(scene, o, r.counters, r.per_primary, r.seconds);
+  nlohmann::json j = stats_json(scene, o, r.counters, r.per_primary, r.seconds, embree_build);
   RunInfo run;
   run.argv = {"amalgam.Scene.render"};
   run.width = r.width;
@@ -191,6 +199,19 @@ struct Scene {
   std::string spec;
   std::shared_ptr<RenderResult> last_result;
   std::mutex last_mutex;
+  /// The tracer of `o`: amalgam's, or Embree's, built on first use and kept for later renders.
+  std::shared_ptr<const Tracer> embree;
+  std::mutex embree_mutex;
+
+  std::shared_ptr<const Tracer> tracer_for(const RenderOptions& o) {
+    if (o.tracer == TracerKind::kAmalgam) return make_tracer(*scene, o);
+    std::lock_guard<std::mutex> lock(embree_mutex);
+    if (!embree) {
+      py::gil_scoped_release nogil;  // Embree's build takes a while on a large scene
+      embree = make_tracer(*scene, o);
+    }
+    return embree;
+  }
 
   std::shared_ptr<RenderResult> render(int width, int height, int spp, const std::string& renderer,
                                        const std::string& opacity, std::optional<int> level,
@@ -198,10 +219,12 @@ struct Scene {
                                        std::uint64_t seed, int threads, const std::string& sampler,
                                        const py::object& camera, const py::object& eye,
                                        const py::object& look_at, const py::object& up,
-                                       const py::object& fov, const py::object& light_samples) {
+                                       const py::object& fov, const py::object& light_samples,
+                                       const std::string& tracer_name) {
     const Options opt = make_options(width, height, spp, renderer, opacity, level, footprint, order,
-                                     seed, threads, sampler);
+                                     seed, threads, sampler, tracer_name);
     check_options(*scene, opt.o, OptionSpelling::kKeywords);
+    std::shared_ptr<const Tracer> tracer = tracer_for(opt.o);
     // Another view of the same built, baked scene: only the environment is new.
     CameraChoice view;
     const std::pair<const char*, const py::object*> keys[] = {
@@ -216,10 +239,10 @@ struct Scene {
     auto cancel = std::make_shared<std::atomic<bool>>(false);
     std::shared_ptr<const LoadedScene> keep = scene;
     const RenderOptions o = opt.o;
-    std::packaged_task<RenderOutput()> task([keep, env, o, cancel] {
+    std::packaged_task<RenderOutput()> task([keep, tracer, env, o, cancel] {
       RenderControl control;
       control.cancel = cancel.get();
-      return amalgam::render(*keep, *env, o, nullptr, control);
+      return tracer->render_view(*env, o, nullptr, control);
     });
     std::future<RenderOutput> done = task.get_future();
     std::optional<py::error_already_set> interrupt;
@@ -237,7 +260,7 @@ struct Scene {
       worker.join();
     }
     RenderOutput out = done.get();  // rethrows a failure of the render
-    auto result = make_result(*scene, o, std::move(out));
+    auto result = make_result(*scene, o, std::move(out), tracer->build_seconds());
     {
       std::lock_guard<std::mutex> lock(last_mutex);
       last_result = result;
@@ -253,10 +276,12 @@ struct Scene {
   py::dict trace(std::optional<std::vector<float>> origin,
                  std::optional<std::vector<float>> direction, int width, int height,
                  const std::string& renderer, const std::string& opacity, std::optional<int> level,
-                 std::optional<float> footprint, const std::string& order, std::uint64_t seed) {
-    const Options opt =
-        make_options(width, height, 1, renderer, opacity, level, footprint, order, seed, 1);
+                 std::optional<float> footprint, const std::string& order, std::uint64_t seed,
+                 const std::string& tracer_name) {
+    const Options opt = make_options(width, height, 1, renderer, opacity, level, footprint, order,
+                                     seed, 1, "independent", tracer_name);
     check_options(*scene, opt.o, OptionSpelling::kKeywords);
+    std::shared_ptr<const Tracer> tracer = tracer_for(opt.o);
     Ray ray = scene->env.camera.centre_ray(width, height);
     auto vec = [](const std::vector<float>& v, const char* what) {
       if (v.size() != 3) throw InputError(std::string(what) + ": expected three numbers x,y,z");
@@ -265,9 +290,9 @@ struct Scene {
       return r;
     };
     if (origin || direction) {
-      const Vec3 o = origin ? vec(*origin, "--origin") : ray.origin;
-      const Vec3 d = direction ? vec(*direction, "--direction") : ray.dir;
-      if (length(d) == 0.0f) throw InputError("--direction: must not be the zero vector");
+      const Vec3 o = origin ? vec(*origin, "origin=") : ray.origin;
+      const Vec3 d = direction ? vec(*direction, "direction=") : ray.dir;
+      if (length(d) == 0.0f) throw InputError("direction=: must not be the zero vector");
       const float spread = ray.cone_spread;
       ray = Ray::make(o, normalize(d));
       ray.cone_spread = spread;
@@ -277,10 +302,10 @@ struct Scene {
     {
       py::gil_scoped_release nogil;
       const auto t0 = std::chrono::steady_clock::now();
-      t = amalgam::trace(*scene, opt.o, ray);
+      t = tracer->trace(opt.o, ray);
       secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
-    return to_python(trace_json(*scene, opt.o, t, secs));
+    return to_python(trace_json(*scene, opt.o, t, secs, tracer->build_seconds()));
   }
 };
 
@@ -396,6 +421,7 @@ PYBIND11_MODULE(amalgam, m) {
       "Bad input raises ValueError, runtime failures RuntimeError, each with the CLI's\n"
       "one-line message. See docs/python.md.";
   m.attr("__version__") = version();
+  m.attr("has_embree") = have_embree();  // tracer="embree" is available
 
   py::register_exception_translator([](std::exception_ptr p) {
     try {
@@ -449,12 +475,14 @@ PYBIND11_MODULE(amalgam, m) {
            py::arg("threads") = 0, py::arg("sampler") = "independent",
            py::arg("camera") = py::none(), py::arg("eye") = py::none(),
            py::arg("look_at") = py::none(), py::arg("up") = py::none(), py::arg("fov") = py::none(),
-           py::arg("light_samples") = py::none(),
+           py::arg("light_samples") = py::none(), py::arg("tracer") = "amalgam",
            "Renders the scene's camera view; the options are the CLI's (docs/cli.md). camera=\n"
            "(name or index), eye=, look_at=, up= (x, y, z) and fov= (degrees) change the view\n"
            "of this render only, as --camera, --eye, --look-at, --up and --fov do, starting from\n"
            "the view `load` chose; the scene is not rebuilt or rebaked. light_samples= is\n"
-           "--light-samples (shadow rays per sized light). The same\n"
+           "--light-samples (shadow rays per sized light). tracer='embree' renders at full\n"
+           "detail with Intel Embree 3 (--tracer embree; its BVHs are built on first use and\n"
+           "kept by the scene). The same\n"
            "seed gives the same image as `amalgam render ... --out x.pfm`, bit for bit, on any\n"
            "number of threads. The GIL is released. Ctrl-C (KeyboardInterrupt) stops the render\n"
            "at its next tile; the exception's `partial` attribute (and scene.last_result) holds\n"
@@ -464,6 +492,7 @@ PYBIND11_MODULE(amalgam, m) {
            py::arg("height") = 512, py::arg("renderer") = "scale-sensitive",
            py::arg("opacity") = "stochastic", py::arg("level") = py::none(),
            py::arg("footprint") = py::none(), py::arg("order") = "sorted", py::arg("seed") = 0,
+           py::arg("tracer") = "amalgam",
            "Traces one primary ray with its shadow rays (`amalgam trace`): by default the\n"
            "camera's centre ray. Returns the CLI's trace JSON as a dict: 'hit' (None or t,\n"
            "object {kind, id, level}, point), 'colour', 'rays', 'tests', ...")

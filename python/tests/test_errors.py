@@ -53,8 +53,10 @@ def test_bad_options_are_value_errors(demo, tmp_path):
         demo.render(width=8, height=8, spp=0)
     with pytest.raises(ValueError, match="^renderer=traditional renders no amalgam: level="):
         demo.render(width=8, height=8, renderer="traditional", level=2)
-    with pytest.raises(ValueError, match="--direction"):
+    with pytest.raises(ValueError, match="^direction=: must not be the zero vector"):
         demo.trace(direction=[0, 0, 0])
+    with pytest.raises(ValueError, match="^tracer=fast: expected amalgam or embree"):
+        demo.render(width=8, height=8, tracer="fast")
     with pytest.raises(ValueError, match="same size"):
         amalgam.compare(np.zeros((2, 2, 3)), np.zeros((3, 2, 3)))
     with pytest.raises(ValueError, match="unknown"):

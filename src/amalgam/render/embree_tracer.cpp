@@ -371,7 +371,7 @@ using EmbreeIntegrator =
 /// The Tracer over Embree's BVHs of one scene.
 class EmbreeTracer final : public Tracer {
  public:
-  EmbreeTracer(const LoadedScene& scene, int threads, const EmbreeBuild& build) {
+  EmbreeTracer(const LoadedScene& scene, int threads, const EmbreeBuild& build) : Tracer(scene) {
     const auto t0 = Clock::now();
     bvh_.loaded = &scene;
     bvh_.build_options = build;
@@ -385,8 +385,8 @@ class EmbreeTracer final : public Tracer {
     bvh_.build_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   }
 
-  RenderOutput render(const RenderOptions& o, FilmState* resume,
-                      const RenderControl& control) const override {
+  RenderOutput render_view(const Environment& env, const RenderOptions& o, FilmState* resume,
+                           const RenderControl& control) const override {
     check(o);
     const LoadedScene& scene = *bvh_.loaded;
     const auto t0 = Clock::now();
@@ -396,8 +396,8 @@ class EmbreeTracer final : public Tracer {
     const bool interrupted = std::visit(
         [&](const auto& h) {
           using H = std::decay_t<decltype(h)>;
-          return render_passes(scene.env.camera, o, st, control, [&](Counters& c) {
-            return EmbreeIntegrator<H>(h, scene.env, EmbreeHits<H>(h, bvh_, c));
+          return render_passes(env.camera, o, st, control, [&](Counters& c) {
+            return EmbreeIntegrator<H>(h, env, EmbreeHits<H>(h, bvh_, c));
           });
         },
         scene.hierarchy);

@@ -15,24 +15,21 @@ namespace {
 /// amalgam's own traversal: the functions of render.h, over the scene as loaded.
 class AmalgamTracer final : public Tracer {
  public:
-  explicit AmalgamTracer(const LoadedScene& scene) : scene_(&scene) {}
+  explicit AmalgamTracer(const LoadedScene& scene) : Tracer(scene) {}
 
-  RenderOutput render(const RenderOptions& o, FilmState* resume,
-                      const RenderControl& control) const override {
-    return amalgam::render(*scene_, o, resume, control);
+  RenderOutput render_view(const Environment& env, const RenderOptions& o, FilmState* resume,
+                           const RenderControl& control) const override {
+    return amalgam::render(scene(), env, o, resume, control);
   }
   bool render_tile(const RenderOptions& o, FilmTile& tile, int s0, int s1,
                    const std::atomic<bool>* cancel) const override {
-    return amalgam::render_tile(*scene_, o, tile, s0, s1, cancel);
+    return amalgam::render_tile(scene(), o, tile, s0, s1, cancel);
   }
   TraceOutput trace(const RenderOptions& o, const Ray& ray) const override {
-    return amalgam::trace(*scene_, o, ray);
+    return amalgam::trace(scene(), o, ray);
   }
   double build_seconds() const override { return 0.0; }
   bool counts_tests() const override { return true; }
-
- private:
-  const LoadedScene* scene_;
 };
 
 }  // namespace

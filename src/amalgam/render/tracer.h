@@ -33,8 +33,14 @@ class Tracer {
   virtual ~Tracer() = default;
 
   /// `render` (render.h) with this tracer: the same progressive passes, resume and control.
-  virtual RenderOutput render(const RenderOptions& options, FilmState* resume = nullptr,
-                              const RenderControl& control = {}) const = 0;
+  RenderOutput render(const RenderOptions& options, FilmState* resume = nullptr,
+                      const RenderControl& control = {}) const {
+    return render_view(scene_->env, options, resume, control);
+  }
+  /// The same with another view of the scene: `env` (camera, lights, background) replaces
+  /// scene.env; the hierarchy (and Embree's BVHs) are shared.
+  virtual RenderOutput render_view(const Environment& env, const RenderOptions& options,
+                                   FilmState* resume, const RenderControl& control) const = 0;
   /// `render_tile` (render.h) with this tracer. False when `cancel` stopped it.
   virtual bool render_tile(const RenderOptions& options, FilmTile& tile, int s0, int s1,
                            const std::atomic<bool>* cancel = nullptr) const = 0;
@@ -47,6 +53,15 @@ class Tracer {
   /// Whether it counts intersection tests (Embree counts rays only: its test counts and per-pixel
   /// costs are zero).
   virtual bool counts_tests() const = 0;
+
+  /// The scene this tracer was made for.
+  const LoadedScene& scene() const { return *scene_; }
+
+ protected:
+  explicit Tracer(const LoadedScene& scene) : scene_(&scene) {}
+
+ private:
+  const LoadedScene* scene_;
 };
 
 /// The tracer `options.tracer` names for `scene`, checked against it first (check_options).
