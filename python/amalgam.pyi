@@ -94,7 +94,8 @@ def load(
 def compare(
     a: Union[RenderResult, npt.ArrayLike], b: Union[RenderResult, npt.ArrayLike]
 ) -> dict[str, float]:
-    """width, height, rmse, psnr, ssim, mean_abs, max_abs, rel_mse (b the reference)."""
+    """width, height, rmse, psnr_db, ssim, mean_abs_error, max_abs_error, rel_mse (b the
+    reference; the names of `amalgam compare --json`)."""
 
 def experiment(
     name: str, quick: bool = True, threads: int = 0, frame: bool = False

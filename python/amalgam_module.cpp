@@ -365,12 +365,7 @@ py::dict compare(const py::object& a, const py::object& b) {
   py::dict d;
   d["width"] = wa;
   d["height"] = ha;
-  d["rmse"] = c.rmse;
-  d["psnr"] = c.psnr;
-  d["ssim"] = c.ssim;
-  d["mean_abs"] = c.mean_abs;
-  d["max_abs"] = c.max_abs;
-  d["rel_mse"] = c.rel_mse;
+  for (const auto& [name, value] : c.named()) d[name] = value;  // the CLI's JSON names
   return d;
 }
 
@@ -416,7 +411,7 @@ PYBIND11_MODULE(amalgam, m) {
       "  scene = amalgam.load('builtin:line', n=4)        # built and baked once\n"
       "  r = scene.render(width=256, height=256, spp=4)   # r.image: float32 H x W x 3\n"
       "  r.cost, r.stats                                  # tests per pixel, stats dict\n"
-      "  amalgam.compare(r, reference)                    # rmse, psnr, ssim, ...\n"
+      "  amalgam.compare(r, reference)                    # rmse, psnr_db, ssim, ...\n"
       "  amalgam.experiment('expected', quick=True)       # the table as a list of dicts\n\n"
       "Bad input raises ValueError, runtime failures RuntimeError, each with the CLI's\n"
       "one-line message. See docs/python.md.";
@@ -523,7 +518,8 @@ PYBIND11_MODULE(amalgam, m) {
   m.def("compare", &compare, py::arg("a"), py::arg("b"),
         "compare(a, b) -> dict\n\n"
         "Image metrics of `amalgam compare` for two H x W x 3 images (arrays or RenderResults),\n"
-        "b the reference: width, height, rmse, psnr, ssim, mean_abs, max_abs, rel_mse.");
+        "b the reference: width, height, rmse, psnr_db, ssim, mean_abs_error, max_abs_error,\n"
+        "rel_mse (the names of `amalgam compare --json`).");
   m.def("experiment", &experiment, py::arg("name"), py::arg("quick") = true, py::arg("threads") = 0,
         py::arg("frame") = false,
         "experiment(name, quick=True, threads=0, frame=False) -> list[dict] | pandas.DataFrame\n\n"

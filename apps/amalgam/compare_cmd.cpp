@@ -66,15 +66,12 @@ int run_compare(const CompareOptions& o) {
   j["b"] = o.b;
   j["width"] = wa;
   j["height"] = ha;
-  j["rmse"] = c.rmse;
-  if (std::isinf(c.psnr))
-    j["psnr_db"] = "inf";  // JSON has no infinity
-  else
-    j["psnr_db"] = c.psnr;
-  j["ssim"] = c.ssim;
-  j["mean_abs_error"] = c.mean_abs;
-  j["max_abs_error"] = c.max_abs;
-  j["rel_mse"] = c.rel_mse;
+  for (const auto& [name, value] : c.named()) {
+    if (std::isinf(value))
+      j[name] = "inf";  // JSON has no infinity (psnr_db of identical images)
+    else
+      j[name] = value;
+  }
   if (!o.error_image.empty()) {
     j["error_image"] = o.error_image;
     j["error_image_max"] = vmax;

@@ -130,12 +130,30 @@ def test_compare(demo):
     a = demo.render(width=32, height=32, spp=1, seed=1)
     b = demo.render(width=32, height=32, spp=8, seed=2)
     same = amalgam.compare(a, a.image)
-    assert same["rmse"] == 0 and same["ssim"] == 1 and same["psnr"] == float("inf")
+    assert same["rmse"] == 0 and same["ssim"] == 1 and same["psnr_db"] == float("inf")
     m = amalgam.compare(a, b)
-    assert set(m) == {"width", "height", "rmse", "psnr", "ssim", "mean_abs", "max_abs", "rel_mse"}
     diff = a.image.astype(np.float64) - b.image
     assert m["rmse"] == pytest.approx(np.sqrt(np.mean(diff * diff)), rel=1e-9)
-    assert m["max_abs"] == pytest.approx(np.abs(diff).max(), rel=1e-6)
+    assert m["max_abs_error"] == pytest.approx(np.abs(diff).max(), rel=1e-6)
+
+
+def test_compare_has_the_clis_names_and_figures(cli, tmp_path):
+    scene = str(pathlib.Path(__file__).resolve().parents[2] / "scenes" / "field-soft.json")
+    files = []
+    for seed in (1, 2):  # soft shadows: two seeds, two different images
+        files.append(tmp_path / f"{seed}.pfm")
+        subprocess.run([cli, "render", scene, "--width", "24", "--height", "16", "--spp", "1",
+                        "--seed", str(seed), "--out", str(files[-1])], check=True,
+                       capture_output=True)
+    out = subprocess.run([cli, "compare", str(files[0]), str(files[1]), "--json"], check=True,
+                         capture_output=True, text=True).stdout
+    expected = json.loads(out)
+    del expected["a"], expected["b"]
+    m = amalgam.compare(read_pfm(files[0]), read_pfm(files[1]))
+    assert list(m) == list(expected)  # the same names in the same order
+    assert 0 < expected["rmse"] and expected["psnr_db"] != "inf"
+    for k in expected:
+        assert m[k] == pytest.approx(expected[k], rel=1e-12), k
 
 
 def test_experiment():

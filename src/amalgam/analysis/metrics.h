@@ -3,6 +3,8 @@
 /// per-pixel error map. Pure functions on linear-RGB pixel arrays laid out as in
 /// write_image (pixel (x, y) at index y * width + x). No I/O.
 
+#include <array>
+#include <utility>
 #include <vector>
 
 #include "amalgam/math/vec.h"
@@ -62,6 +64,17 @@ struct ImageComparison {
   double mean_abs = 0;  ///< mean |a - b| over all channels
   double max_abs = 0;   ///< largest |a - b| over all channels
   double rel_mse = 0;   ///< rel_mse(a, b): b is the reference
+
+  /// The figures as (name, value), in the order and with the names both `amalgam compare
+  /// --json` and Python's `amalgam.compare` give them (psnr_db: +inf for identical images).
+  std::array<std::pair<const char*, double>, 6> named() const {
+    return {{{"rmse", rmse},
+             {"psnr_db", psnr},
+             {"ssim", ssim},
+             {"mean_abs_error", mean_abs},
+             {"max_abs_error", max_abs},
+             {"rel_mse", rel_mse}}};
+  }
 };
 
 /// All the metrics above for two width x height images. Throws MetricsError if either
