@@ -257,6 +257,22 @@ TEST(Experiments, PremiseRendersEveryScene) {
   }
   EXPECT_EQ(scenes.size(), 4u) << "two builtin views, the Wuson mesh and the field";
   for (const Check& c : r.checks) EXPECT_EQ(c.statement, "No slower") << c.what;
+  // The findings name the slowest scale-sensitive render (time relative to traditional) with
+  // that render's own test ratio.
+  std::size_t slowest = r.table.rows.size();
+  for (std::size_t i = 0; i < r.table.rows.size(); ++i)
+    if (r.table.at(i, "config") != 0 &&
+        (slowest == r.table.rows.size() ||
+         r.table.at(i, "time_vs_trad") > r.table.at(slowest, "time_vs_trad")))
+      slowest = i;
+  ASSERT_LT(slowest, r.table.rows.size());
+  const std::string said =
+      "it took at most " + fmt(r.table.at(slowest, "time_vs_trad")) + " times as long (";
+  const std::size_t at = r.findings.find(said);
+  ASSERT_NE(at, std::string::npos) << r.findings;
+  const std::string made =
+      ", which made " + fmt(r.table.at(slowest, "tests_vs_trad")) + " times the traditional";
+  EXPECT_NE(r.findings.find(made, at), std::string::npos) << r.findings;
 }
 
 // Sorting: in the worst case both orders make the same tests (C_t0 for the primary and the
