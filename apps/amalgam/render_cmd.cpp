@@ -26,6 +26,7 @@
 #include "amalgam/render/embree_tracer.h"
 #endif
 #include "amalgam/util/atomic_file.h"
+#include "amalgam/util/file_kind.h"
 #include "amalgam/util/version.h"
 #include "common.h"
 #if defined(AMALGAM_HAVE_MPI)
@@ -237,6 +238,11 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
   try {
     common.finish();
     if (!extra.cost_range.empty()) given_range = parse_cost_range(extra.cost_range);
+    // A checkpoint to resume must be a regular file: known before any work (read_checkpoint
+    // refuses it too, without opening a FIFO for reading, which would wait for a writer).
+    if (extra.resume && root)
+      if (const std::string why = not_a_regular_file(ckpt); !why.empty())
+        throw InputError(ckpt + ": " + why + ": cannot resume from it");
     if (root) check_outputs(extra, ckpt, o, common.scene);  // the outputs are rank 0's
     const std::uint64_t asked =
         extra.max_memory.empty() ? 0 : parse_bytes(extra.max_memory, "--max-memory");
@@ -440,8 +446,16 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
               << " (continue with the same command and --resume)\n";
     return 1;
   }
-  std::error_code ec;
-  std::filesystem::remove(ckpt, ec);  // complete: the checkpoint is no longer needed
+  // Complete: the checkpoint is no longer needed. What is removed is the file it was written to:
+  // through a symbolic link, its target (the link is the user's and stays); a device or FIFO
+  // is never removed.
+  try {
+    const OutputTarget t = resolve_output(ckpt);
+    std::error_code ec;
+    if (t.kind == OutputTarget::Kind::kFile && std::filesystem::is_regular_file(t.path, ec))
+      std::filesystem::remove(t.path, ec);
+  } catch (const InputError&) {  // its directory went away meanwhile: nothing to remove
+  }
   if (!extra.quiet) {
     std::cerr << "amalgam: wrote " << extra.out << " (" << r.width << "x" << r.height << ", "
               << r.spp << " spp, " << r.seconds << " s, ";

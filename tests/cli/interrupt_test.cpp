@@ -232,6 +232,67 @@ TEST(CliInterrupt, ResumeRefusesOtherSettingsADamagedCheckpointAndAnEditedScene)
   EXPECT_EQ(run(srender + sres), 0) << "the same scene again is";
 }
 
+/// Runs `sh -c SCRIPT` bounded by `timeout 10`, SIGKILL a second later (a hang fails the test,
+/// never the suite); its exit status (124 or 137: it timed out) and stderr (`err`).
+int run_bounded(const std::string& script, const fs::path& err) {
+  const std::string cmd = "timeout -k 1 10 sh -c '" + script + "' 2>" + err.string();
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+}
+
+// A checkpoint to resume that is not a regular file is refused at once, naming it: a character
+// device used to be read without end (memory grew until it ran out), a FIFO waited forever for
+// a writer.
+TEST(CliInterrupt, ResumeRefusesACheckpointThatIsNotARegularFile) {
+  Dir d("special");
+  const std::string fifo = (d.path / "fifo.ckpt").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::string& ckpt : {std::string("/dev/zero"), fifo}) {
+    const auto t0 = std::chrono::steady_clock::now();
+    // Bounded address space (not under ASan, which reserves terabytes): a reader without end
+    // runs out instead of taking the machine's memory.
+#if defined(__SANITIZE_ADDRESS__)
+    const std::string limit;
+#else
+    const std::string limit = "ulimit -v 600000; ";
+#endif
+    const int st =
+        run_bounded(limit + "exec " + std::string(AMALGAM_BINARY) +
+                        " render builtin:prisms --set depth=3 --width 8 --height 8 "
+                        "--spp 2 --quiet --out " +
+                        (d.path / "x.pfm").string() + " --checkpoint " + ckpt + " --resume",
+                    d.path / "err.txt");
+    const std::string err = slurp(d.path / "err.txt");
+    EXPECT_EQ(st, 2) << ckpt << ": " << err;
+    EXPECT_NE(err.find(ckpt + ": is a "), std::string::npos) << err;
+    EXPECT_NE(err.find("not a regular file"), std::string::npos) << err;
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  }
+  EXPECT_FALSE(fs::exists(d.path / "x.pfm"));
+}
+
+// --checkpoint through a symbolic link: written through it (the link kept), and once the
+// resumed render is complete the checkpoint it leads to is removed, the link still kept.
+TEST(CliInterrupt, ACheckpointThroughASymbolicLinkKeepsTheLink) {
+  Dir d("ckptlink");
+  fs::create_directories(d.path / "store");
+  const fs::path target = d.path / "store" / "run.ckpt", link = d.path / "run.ckpt";
+  fs::create_symlink(target, link);
+  const std::string out = (d.path / "run.pfm").string();
+  const std::string args = " --out " + out + " --checkpoint " + link.string();
+  const pid_t pid = start(kRender + " --spp 1000000" + args, d.path / "err.txt");
+  ASSERT_TRUE(wait_for(target, pid)) << slurp(d.path / "err.txt");
+  kill(pid, SIGINT);
+  ASSERT_EQ(finish(pid), 1) << slurp(d.path / "err.txt");
+  ASSERT_TRUE(fs::is_symlink(link));
+  const int held = samples_held(slurp(d.path / "err.txt"));
+  ASSERT_GE(held, 1);
+  ASSERT_EQ(run(kRender + " --spp " + std::to_string(held + 1) + args + " --resume"), 0);
+  EXPECT_TRUE(fs::is_symlink(link)) << "the link was removed";
+  EXPECT_EQ(fs::read_symlink(link), target);
+  EXPECT_FALSE(fs::exists(target)) << "the stale checkpoint was left at the link's target";
+}
+
 #if defined(AMALGAM_HAVE_EMBREE)
 TEST(CliInterrupt, EmbreeResumesItsOwnCheckpointButNotAmalgams) {
   Dir d("embree");
