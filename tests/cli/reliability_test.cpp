@@ -342,6 +342,42 @@ TEST(BadInput, OneClearLineForEmptyBinaryLongOrLoopingInput) {
   }
 }
 
+// Messages say what is wrong: a --footprint out of range names the range (1e-300 used to be
+// "expected a number > 0"), a scene that is not a regular file says what it is (not "no such
+// file"), and a FIFO is never opened (it would wait for a writer).
+TEST(BadInput, MessagesSayTheRealBoundAndWhatTheFileIs) {
+  Dir d("say");
+  const std::string out = " --out " + (d / "x.png");
+  for (const char* k : {"1e-300", "1e300", "1e-31", "2e30", "0", "-1", "1e999"}) {
+    const CliResult r = amalgam(kSmall + out + " --footprint " + k);
+    EXPECT_EQ(r.status, 2) << k << ": " << r.err;
+    EXPECT_NE(r.err.find("[1e-30, 1e30]"), std::string::npos) << k << ": " << r.err;
+  }
+  for (const char* k : {"1e-30", "1e30", "0.5"})
+    EXPECT_EQ(amalgam(kSmall + out + " --footprint " + k).status, 0) << k;
+  fs::remove(d / "x.png");
+
+  fs::create_directories(d.path / "dir.json");
+  fs::create_directories(d.path / "dir");
+  ASSERT_EQ(::mkfifo((d / "fifo.json").c_str(), 0600), 0);
+  ASSERT_EQ(::mkfifo((d / "fifo.obj").c_str(), 0600), 0);
+  struct Case {
+    std::string scene, message;
+  };
+  const Case cases[] = {{d / "dir.json", "is a directory"},
+                        {d / "dir", "is a directory"},
+                        {d / "fifo.json", "is a FIFO, not a regular file"},
+                        {d / "fifo.obj", "is a FIFO, not a regular file"},
+                        {"/dev/null", "is a character device, not a regular file"}};
+  for (const Case& c : cases) {
+    const CliResult r = amalgam_bounded("render " + c.scene + out + " --quiet");
+    EXPECT_EQ(r.status, 2) << c.scene << ": " << r.err;
+    EXPECT_NE(r.err.find(c.scene + ": " + c.message), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("no such file"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(d / "x.png"));
+}
+
 TEST(BadInput, OptionsThatDoNotApplyAreRefused) {
   Dir d("apply");
   const std::string out = " --out " + (d / "x.png");

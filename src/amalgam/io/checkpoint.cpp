@@ -125,11 +125,18 @@ FilmState read_checkpoint(const std::string& path, const std::string& fingerprin
     const std::string head(magic, got);
     if (head.compare(0, sizeof kMagicPrefix - 1, kMagicPrefix) != 0)
       throw InputError(path + ": not an amalgam checkpoint");
+    // "AMALGAM-CHECKPOINT-<digits>\0" is a checkpoint of another format; anything else there
+    // (a flipped byte) is damage, whatever digits it starts with.
+    std::size_t i = sizeof kMagicPrefix - 1;
     std::string format;
-    for (std::size_t i = sizeof kMagicPrefix - 1;
-         i < head.size() && format.size() < 4 && std::isdigit(static_cast<unsigned char>(head[i]));
-         ++i)
-      format += head[i];
+    while (i < head.size() && format.size() < 4 &&
+           std::isdigit(static_cast<unsigned char>(head[i])))
+      format += head[i++];
+    if (format.empty() || format == kMagic + sizeof kMagicPrefix - 1 || i >= head.size() ||
+        head[i] != '\0')
+      throw InputError(path +
+                       ": checkpoint is damaged (its header is not that of any format): "
+                       "delete it to start over");
     throw InputError(path + ": checkpoint of another amalgam version (format " + format +
                      ", this one reads format 5): delete it and render again");
   }
