@@ -40,11 +40,13 @@ namespace {
 
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
-std::atomic<int> g_signals{0};         ///< SIGINT/SIGTERM received
+std::atomic<int> g_signals{0};  ///< stop signals received
+/// The signals that stop a render and keep its work (on_signal).
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
 std::atomic<bool> g_finishing{false};  ///< the render is done: its outputs are being written
 
-/// SIGINT/SIGTERM: the first stops the render at the next tile; the image so far and a
-/// checkpoint are then written. Once the outputs are being written, finishing them wins: a
+/// SIGINT, SIGTERM, SIGHUP, SIGQUIT: the first stops the render at the next tile; the image so far
+/// and a checkpoint are then written. Once the outputs are being written, finishing them wins: a
 /// further signal is noted, and only a third in all ends the process at once, removing the
 /// temporary being written (nothing half-written stays).
 extern "C" void on_signal(int sig) {
@@ -54,6 +56,20 @@ extern "C" void on_signal(int sig) {
   if (g_finishing.load() && n >= 3) {
     remove_temporary_from_signal_handler();
     ::_exit(128 + sig);
+  }
+}
+
+/// "SIGINT", "SIGTERM", "SIGHUP" or "SIGQUIT".
+const char* signal_name(int sig) {
+  switch (sig) {
+    case SIGTERM:
+      return "SIGTERM";
+    case SIGHUP:
+      return "SIGHUP";
+    case SIGQUIT:
+      return "SIGQUIT";
+    default:
+      return "SIGINT";
   }
 }
 
@@ -306,12 +322,18 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
 #endif
   const LoadedScene& scene = *loaded;
 
+  // SIGHUP (a closed terminal, a dropped SSH session) and SIGQUIT stop the render as SIGINT and
+  // SIGTERM do. A signal ignored at start stays ignored: nohup ignores SIGHUP, and a shell
+  // ignores SIGINT and SIGQUIT in the background jobs it starts, so they outlive a Ctrl-C.
   struct sigaction sa {};
   sa.sa_handler = on_signal;
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = SA_RESTART;
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
+  for (const int sig : kStopSignals) {
+    struct sigaction old {};
+    if (sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    sigaction(sig, &sa, nullptr);
+  }
 #if defined(AMALGAM_HAVE_MPI)
   // What renders a tile on this rank: amalgam's traversal or Embree, as for one process.
   const mpi::TileRenderer tile_renderer = [&](FilmTile& t, int s0, int s1,
@@ -440,9 +462,9 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
       if (!stop.missing.empty()) std::cerr << "amalgam: " << stop.missing << "\n";
     }
 #endif
-    std::cerr << "amalgam: interrupted by " << (sig == SIGTERM ? "SIGTERM" : "SIGINT") << where
-              << ": " << (r.spp > 0 ? extra.out : std::string("no image")) << " holds " << r.spp
-              << " of " << o.spp << " samples per pixel; checkpoint " << ckpt
+    std::cerr << "amalgam: interrupted by " << signal_name(sig) << where << ": "
+              << (r.spp > 0 ? extra.out : std::string("no image")) << " holds " << r.spp << " of "
+              << o.spp << " samples per pixel; checkpoint " << ckpt
               << " (continue with the same command and --resume)\n";
     return 1;
   }

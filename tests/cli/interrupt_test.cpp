@@ -9,6 +9,7 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <spawn.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,6 +21,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "cli_support.h"
@@ -291,6 +293,66 @@ TEST(CliInterrupt, ACheckpointThroughASymbolicLinkKeepsTheLink) {
   EXPECT_TRUE(fs::is_symlink(link)) << "the link was removed";
   EXPECT_EQ(fs::read_symlink(link), target);
   EXPECT_FALSE(fs::exists(target)) << "the stale checkpoint was left at the link's target";
+}
+
+// SIGHUP (a closed terminal, a dropped SSH session) and SIGQUIT keep the work as SIGTERM does.
+TEST(CliInterrupt, SighupAndSigquitDoTheSame) {
+  for (const auto& [sig, name] : {std::pair{SIGHUP, "SIGHUP"}, std::pair{SIGQUIT, "SIGQUIT"}}) {
+    Dir d(name);
+    const std::string out = (d.path / "run.pfm").string();
+    EXPECT_EQ(interrupt(d, out, {sig}), 1) << name;
+    const std::string err = slurp(d.path / "err.txt");
+    EXPECT_NE(err.find(std::string("interrupted by ") + name), std::string::npos) << err;
+    EXPECT_GE(samples_held(err), 1) << err;
+    EXPECT_EQ(fs::file_size(out), pfm_size(64, 48));
+    EXPECT_TRUE(fs::exists(out + ".ckpt"));
+  }
+}
+
+/// The inode of `p`, 0 if it does not exist (each atomic write of a file makes a new one).
+ino_t inode(const fs::path& p) {
+  struct stat st {};
+  return ::stat(p.c_str(), &st) == 0 ? st.st_ino : 0;
+}
+
+// A signal ignored when amalgam starts stays ignored (nohup ignores SIGHUP; a non-interactive
+// shell ignores SIGINT in the jobs it starts with &): the render goes on through it, writing
+// checkpoints, and stops only on SIGTERM.
+TEST(CliInterrupt, ASignalIgnoredAtStartStaysIgnored) {
+  Dir d("ignored");
+  const std::string out = (d.path / "run.pfm").string(), ckpt = out + ".ckpt";
+  std::vector<std::string> words = {"/bin/sh", "-c", "trap \"\" INT HUP; exec \"$0\" \"$@\"",
+                                    AMALGAM_BINARY};
+  for (const std::string& w : split(kRender + " --spp 1000000 --out " + out)) words.push_back(w);
+  std::vector<char*> argv;
+  for (std::string& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  const std::string err = (d.path / "err.txt").string();
+  posix_spawn_file_actions_addopen(&fa, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = -1;
+  ASSERT_EQ(posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&fa);
+  ASSERT_TRUE(wait_for(ckpt, pid)) << slurp(err);
+  kill(pid, SIGINT);
+  kill(pid, SIGHUP);
+  // Still rendering: three more checkpoints after the signals (a render they stopped would
+  // write at most two: at the end of the pass under way and the final one).
+  ino_t last = inode(ckpt);
+  int written = 0;
+  for (int i = 0; i < 6000 && written < 3; ++i) {
+    int st = 0;
+    if (waitpid(pid, &st, WNOHANG) == pid) {
+      FAIL() << "ended by an ignored signal: " << slurp(err);
+    }
+    if (const ino_t now = inode(ckpt); now != 0 && now != last) last = now, ++written;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(written, 3);
+  kill(pid, SIGTERM);
+  EXPECT_EQ(finish(pid), 1);
+  EXPECT_NE(slurp(err).find("interrupted by SIGTERM"), std::string::npos) << slurp(err);
 }
 
 #if defined(AMALGAM_HAVE_EMBREE)
