@@ -38,12 +38,12 @@ void CommonOptions::add_to(CLI::App& app) {
                 try {
                   std::size_t end = 0;
                   const double x = std::stod(v, &end);
-                  if (end == v.size() && x > 0.0 && x < 1e30) return "";
-                } catch (const std::exception&) {
+                  if (end == v.size() && x >= kMinFootprint && x <= kMaxFootprint) return "";
+                } catch (const std::exception&) {  // out_of_range: beyond double's range
                 }
-                return "expected a number > 0";
+                return "expected a number in [1e-30, 1e30]";
               },
-              "K > 0"));
+              "K in [1e-30, 1e30]"));
   order_option = app.add_option("--order", order,
                                 "sorted (default): nearest child first; unsorted: stored order")
                      ->check(CLI::IsMember({"sorted", "unsorted"}));

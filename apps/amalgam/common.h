@@ -20,7 +20,7 @@ struct CommonOptions {
   std::string opacity = "stochastic";
   std::string order = "sorted";
   int level = -1;
-  float footprint = 1.0f;
+  double footprint = 1.0;  ///< as given: resolve_options checks its range
   std::string seed = "0";
   std::string sampler = "independent";  ///< render only (registered in main.cpp)
   int threads = 0;

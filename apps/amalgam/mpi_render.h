@@ -54,7 +54,7 @@ using TileRenderer =
 
 /// Why a parallel render stopped early (rank 0).
 struct Stop {
-  int signal = 0;       ///< the signal that stopped it (SIGINT or SIGTERM)
+  int signal = 0;       ///< the signal that stopped it (SIGINT, SIGTERM, SIGHUP or SIGQUIT)
   int signal_rank = 0;  ///< the rank that received it
   std::string missing;  ///< the tiles of the unfinished round not returned, and their holders
 };
@@ -71,7 +71,8 @@ RenderOutput render_root(const TileRenderer& render_tile, const RenderOptions& o
                          Stop& stop);
 
 /// Ranks > 0: renders the tiles rank 0 hands out until it says stop. `cancel` (this process's
-/// SIGINT/SIGTERM) stops the tile under way and tells rank 0, which stops every rank.
+/// SIGINT, SIGTERM, SIGHUP, SIGQUIT) stops the tile under way and tells rank 0, which stops every
+/// rank.
 void serve(const TileRenderer& render_tile, const RenderOptions& options,
            const std::atomic<bool>& cancel, const std::atomic<int>& signal);
 

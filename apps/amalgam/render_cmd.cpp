@@ -24,6 +24,7 @@
 #include "amalgam/render/render.h"
 #include "amalgam/render/tracer.h"
 #include "amalgam/util/atomic_file.h"
+#include "amalgam/util/file_kind.h"
 #include "amalgam/util/version.h"
 #include "common.h"
 #if defined(AMALGAM_HAVE_MPI)
@@ -37,11 +38,13 @@ namespace {
 
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
-std::atomic<int> g_signals{0};         ///< SIGINT/SIGTERM received
+std::atomic<int> g_signals{0};  ///< stop signals received
+/// The signals that stop a render and keep its work (on_signal).
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
 std::atomic<bool> g_finishing{false};  ///< the render is done: its outputs are being written
 
-/// SIGINT/SIGTERM: the first stops the render at the next tile; the image so far and a
-/// checkpoint are then written. Once the outputs are being written, finishing them wins: a
+/// SIGINT, SIGTERM, SIGHUP, SIGQUIT: the first stops the render at the next tile; the image so far
+/// and a checkpoint are then written. Once the outputs are being written, finishing them wins: a
 /// further signal is noted, and only a third in all ends the process at once, removing the
 /// temporary being written (nothing half-written stays).
 extern "C" void on_signal(int sig) {
@@ -51,6 +54,20 @@ extern "C" void on_signal(int sig) {
   if (g_finishing.load() && n >= 3) {
     remove_temporary_from_signal_handler();
     ::_exit(128 + sig);
+  }
+}
+
+/// "SIGINT", "SIGTERM", "SIGHUP" or "SIGQUIT".
+const char* signal_name(int sig) {
+  switch (sig) {
+    case SIGTERM:
+      return "SIGTERM";
+    case SIGHUP:
+      return "SIGHUP";
+    case SIGQUIT:
+      return "SIGQUIT";
+    default:
+      return "SIGINT";
   }
 }
 
@@ -232,6 +249,11 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
   try {
     common.finish();
     if (!extra.cost_range.empty()) given_range = parse_cost_range(extra.cost_range);
+    // A checkpoint to resume must be a regular file: known before any work (read_checkpoint
+    // refuses it too, without opening a FIFO for reading, which would wait for a writer).
+    if (extra.resume && root)
+      if (const std::string why = not_a_regular_file(ckpt); !why.empty())
+        throw InputError(ckpt + ": " + why + ": cannot resume from it");
     if (root) check_outputs(extra, ckpt, o, common.scene);  // the outputs are rank 0's
     const std::uint64_t asked =
         extra.max_memory.empty() ? 0 : parse_bytes(extra.max_memory, "--max-memory");
@@ -291,12 +313,18 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
 #endif
   const LoadedScene& scene = *loaded;
 
+  // SIGHUP (a closed terminal, a dropped SSH session) and SIGQUIT stop the render as SIGINT and
+  // SIGTERM do. A signal ignored at start stays ignored: nohup ignores SIGHUP, and a shell
+  // ignores SIGINT and SIGQUIT in the background jobs it starts, so they outlive a Ctrl-C.
   struct sigaction sa {};
   sa.sa_handler = on_signal;
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = SA_RESTART;
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
+  for (const int sig : kStopSignals) {
+    struct sigaction old {};
+    if (sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    sigaction(sig, &sa, nullptr);
+  }
 #if defined(AMALGAM_HAVE_MPI)
   // What renders a tile on this rank: amalgam's traversal or Embree, as for one process.
   const mpi::TileRenderer tile_renderer = [&](FilmTile& t, int s0, int s1,
@@ -417,14 +445,22 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
       if (!stop.missing.empty()) std::cerr << "amalgam: " << stop.missing << "\n";
     }
 #endif
-    std::cerr << "amalgam: interrupted by " << (sig == SIGTERM ? "SIGTERM" : "SIGINT") << where
-              << ": " << (r.spp > 0 ? extra.out : std::string("no image")) << " holds " << r.spp
-              << " of " << o.spp << " samples per pixel; checkpoint " << ckpt
+    std::cerr << "amalgam: interrupted by " << signal_name(sig) << where << ": "
+              << (r.spp > 0 ? extra.out : std::string("no image")) << " holds " << r.spp << " of "
+              << o.spp << " samples per pixel; checkpoint " << ckpt
               << " (continue with the same command and --resume)\n";
     return 1;
   }
-  std::error_code ec;
-  std::filesystem::remove(ckpt, ec);  // complete: the checkpoint is no longer needed
+  // Complete: the checkpoint is no longer needed. What is removed is the file it was written to:
+  // through a symbolic link, its target (the link is the user's and stays); a device or FIFO
+  // is never removed.
+  try {
+    const OutputTarget t = resolve_output(ckpt);
+    std::error_code ec;
+    if (t.kind == OutputTarget::Kind::kFile && std::filesystem::is_regular_file(t.path, ec))
+      std::filesystem::remove(t.path, ec);
+  } catch (const InputError&) {  // its directory went away meanwhile: nothing to remove
+  }
   if (!extra.quiet) {
     std::cerr << "amalgam: wrote " << extra.out << " (" << r.width << "x" << r.height << ", "
               << r.spp << " spp, " << r.seconds << " s, ";

@@ -9,6 +9,7 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <spawn.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,6 +21,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "cli_support.h"
@@ -230,6 +232,127 @@ TEST(CliInterrupt, ResumeRefusesOtherSettingsADamagedCheckpointAndAnEditedScene)
   EXPECT_NE(slurp(serr).find("different settings"), std::string::npos) << slurp(serr);
   write_scene("[0.8, 0.2, 0.2]");
   EXPECT_EQ(run(srender + sres), 0) << "the same scene again is";
+}
+
+/// Runs `sh -c SCRIPT` bounded by `timeout 10`, SIGKILL a second later (a hang fails the test,
+/// never the suite); its exit status (124 or 137: it timed out) and stderr (`err`).
+int run_bounded(const std::string& script, const fs::path& err) {
+  const std::string cmd = "timeout -k 1 10 sh -c '" + script + "' 2>" + err.string();
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+}
+
+// A checkpoint to resume that is not a regular file is refused at once, naming it: a character
+// device used to be read without end (memory grew until it ran out), a FIFO waited forever for
+// a writer.
+TEST(CliInterrupt, ResumeRefusesACheckpointThatIsNotARegularFile) {
+  Dir d("special");
+  const std::string fifo = (d.path / "fifo.ckpt").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::string& ckpt : {std::string("/dev/zero"), fifo}) {
+    const auto t0 = std::chrono::steady_clock::now();
+    // Bounded address space (not under ASan, which reserves terabytes): a reader without end
+    // runs out instead of taking the machine's memory.
+#if defined(__SANITIZE_ADDRESS__)
+    const std::string limit;
+#else
+    const std::string limit = "ulimit -v 600000; ";
+#endif
+    const int st =
+        run_bounded(limit + "exec " + std::string(AMALGAM_BINARY) +
+                        " render builtin:prisms --set depth=3 --width 8 --height 8 "
+                        "--spp 2 --quiet --out " +
+                        (d.path / "x.pfm").string() + " --checkpoint " + ckpt + " --resume",
+                    d.path / "err.txt");
+    const std::string err = slurp(d.path / "err.txt");
+    EXPECT_EQ(st, 2) << ckpt << ": " << err;
+    EXPECT_NE(err.find(ckpt + ": is a "), std::string::npos) << err;
+    EXPECT_NE(err.find("not a regular file"), std::string::npos) << err;
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  }
+  EXPECT_FALSE(fs::exists(d.path / "x.pfm"));
+}
+
+// --checkpoint through a symbolic link: written through it (the link kept), and once the
+// resumed render is complete the checkpoint it leads to is removed, the link still kept.
+TEST(CliInterrupt, ACheckpointThroughASymbolicLinkKeepsTheLink) {
+  Dir d("ckptlink");
+  fs::create_directories(d.path / "store");
+  const fs::path target = d.path / "store" / "run.ckpt", link = d.path / "run.ckpt";
+  fs::create_symlink(target, link);
+  const std::string out = (d.path / "run.pfm").string();
+  const std::string args = " --out " + out + " --checkpoint " + link.string();
+  const pid_t pid = start(kRender + " --spp 1000000" + args, d.path / "err.txt");
+  ASSERT_TRUE(wait_for(target, pid)) << slurp(d.path / "err.txt");
+  kill(pid, SIGINT);
+  ASSERT_EQ(finish(pid), 1) << slurp(d.path / "err.txt");
+  ASSERT_TRUE(fs::is_symlink(link));
+  const int held = samples_held(slurp(d.path / "err.txt"));
+  ASSERT_GE(held, 1);
+  ASSERT_EQ(run(kRender + " --spp " + std::to_string(held + 1) + args + " --resume"), 0);
+  EXPECT_TRUE(fs::is_symlink(link)) << "the link was removed";
+  EXPECT_EQ(fs::read_symlink(link), target);
+  EXPECT_FALSE(fs::exists(target)) << "the stale checkpoint was left at the link's target";
+}
+
+// SIGHUP (a closed terminal, a dropped SSH session) and SIGQUIT keep the work as SIGTERM does.
+TEST(CliInterrupt, SighupAndSigquitDoTheSame) {
+  for (const auto& [sig, name] : {std::pair{SIGHUP, "SIGHUP"}, std::pair{SIGQUIT, "SIGQUIT"}}) {
+    Dir d(name);
+    const std::string out = (d.path / "run.pfm").string();
+    EXPECT_EQ(interrupt(d, out, {sig}), 1) << name;
+    const std::string err = slurp(d.path / "err.txt");
+    EXPECT_NE(err.find(std::string("interrupted by ") + name), std::string::npos) << err;
+    EXPECT_GE(samples_held(err), 1) << err;
+    EXPECT_EQ(fs::file_size(out), pfm_size(64, 48));
+    EXPECT_TRUE(fs::exists(out + ".ckpt"));
+  }
+}
+
+/// The inode of `p`, 0 if it does not exist (each atomic write of a file makes a new one).
+ino_t inode(const fs::path& p) {
+  struct stat st {};
+  return ::stat(p.c_str(), &st) == 0 ? st.st_ino : 0;
+}
+
+// A signal ignored when amalgam starts stays ignored (nohup ignores SIGHUP; a non-interactive
+// shell ignores SIGINT in the jobs it starts with &): the render goes on through it, writing
+// checkpoints, and stops only on SIGTERM.
+TEST(CliInterrupt, ASignalIgnoredAtStartStaysIgnored) {
+  Dir d("ignored");
+  const std::string out = (d.path / "run.pfm").string(), ckpt = out + ".ckpt";
+  std::vector<std::string> words = {"/bin/sh", "-c", "trap \"\" INT HUP; exec \"$0\" \"$@\"",
+                                    AMALGAM_BINARY};
+  for (const std::string& w : split(kRender + " --spp 1000000 --out " + out)) words.push_back(w);
+  std::vector<char*> argv;
+  for (std::string& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  const std::string err = (d.path / "err.txt").string();
+  posix_spawn_file_actions_addopen(&fa, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = -1;
+  ASSERT_EQ(posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&fa);
+  ASSERT_TRUE(wait_for(ckpt, pid)) << slurp(err);
+  kill(pid, SIGINT);
+  kill(pid, SIGHUP);
+  // Still rendering: three more checkpoints after the signals (a render they stopped would
+  // write at most two: at the end of the pass under way and the final one).
+  ino_t last = inode(ckpt);
+  int written = 0;
+  for (int i = 0; i < 6000 && written < 3; ++i) {
+    int st = 0;
+    if (waitpid(pid, &st, WNOHANG) == pid) {
+      FAIL() << "ended by an ignored signal: " << slurp(err);
+    }
+    if (const ino_t now = inode(ckpt); now != 0 && now != last) last = now, ++written;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(written, 3);
+  kill(pid, SIGTERM);
+  EXPECT_EQ(finish(pid), 1);
+  EXPECT_NE(slurp(err).find("interrupted by SIGTERM"), std::string::npos) << slurp(err);
 }
 
 #if defined(AMALGAM_HAVE_EMBREE)

@@ -5,19 +5,25 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <future>
 #include <iterator>
 #include <regex>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -45,19 +51,30 @@ struct CliResult {
   double seconds;
 };
 
-/// Runs amalgam with `args` (in directory `cwd` if not empty); its status and stderr.
-CliResult amalgam(const std::string& args, const std::string& cwd = {}) {
+/// Runs `wrapper` amalgam `args` (in directory `cwd` if not empty); its status and stderr.
+CliResult amalgam_via(const std::string& wrapper, const std::string& args, const std::string& cwd) {
   const std::string err =
       fs::temp_directory_path() / ("amalgam-rel-err-" + std::to_string(getpid()));
   const auto t0 = std::chrono::steady_clock::now();
   const std::string cd = cwd.empty() ? std::string() : "cd '" + cwd + "' && ";
-  const int st = std::system((cd + std::string(AMALGAM_BINARY) + " " + args + " 2>" + err).c_str());
+  const int st =
+      std::system((cd + wrapper + std::string(AMALGAM_BINARY) + " " + args + " 2>" + err).c_str());
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   CliResult r{WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st), slurp(err), s};
   fs::remove(err);
   return r;
 }
 
+/// Runs amalgam with `args` (in directory `cwd` if not empty); its status and stderr.
+CliResult amalgam(const std::string& args, const std::string& cwd = {}) {
+  return amalgam_via("", args, cwd);
+}
+
+/// amalgam under `timeout 10` (SIGKILL a second later if SIGTERM does not end it): a run that
+/// hangs, or works for minutes before it fails, ends rather than holding up the suite.
+CliResult amalgam_bounded(const std::string& args) {
+  return amalgam_via("timeout -k 1 10 ", args, {});
+}
 const std::string kSmall =
     "render builtin:prisms --set depth=3 --width 8 --height 8 --spp 1 --quiet";
 /// A render that takes minutes: an output check that comes only after the work would show.
@@ -76,16 +93,92 @@ TEST(Outputs, DevicesAndFifosAreWrittenThroughNeverReplaced) {
   struct stat st {};
   ASSERT_EQ(::stat(null.c_str(), &st), 0);
   EXPECT_TRUE(S_ISCHR(st.st_mode)) << null << " is no longer a character device";
-  // A FIFO: the JSON arrives through it, and it stays a FIFO.
+  // A FIFO: the JSON arrives through it, and it stays a FIFO. Its reader is there before
+  // amalgam starts (a FIFO nobody reads is refused); the JSON fits in the pipe's buffer, so it
+  // is read once amalgam has ended.
   const std::string fifo = d / "fifo";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  auto reader = std::async(std::launch::async, [&] { return slurp(fifo); });
+  const int reader = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  ASSERT_GE(reader, 0);
   const CliResult f = amalgam(kSmall + " --out " + (d / "y.png") + " --stats " + fifo);
   EXPECT_EQ(f.status, 0) << f.err;
-  const std::string json = reader.get();
+  std::string json;
+  char buf[4096];
+  for (ssize_t n; (n = ::read(reader, buf, sizeof buf)) > 0;) json.append(buf, n);
+  ::close(reader);
   EXPECT_NE(json.find("\"tests\""), std::string::npos) << json;
   ASSERT_EQ(::stat(fifo.c_str(), &st), 0);
   EXPECT_TRUE(S_ISFIFO(st.st_mode));
+}
+
+// An output that cannot be opened for writing is refused before any work, exit 2, one line
+// naming it: a socket, a FIFO that no process reads (writing it would wait forever), a device
+// whose driver is missing (ENXIO). They used to pass the check and fail after the render.
+TEST(Outputs, ASocketAFifoNobodyReadsAndADeadDeviceAreRefusedBeforeAnyWork) {
+  Dir d("unopenable");
+  const std::string sock = d / "sock.png";
+  const int s = ::socket(AF_UNIX, SOCK_STREAM, 0);
+  ASSERT_GE(s, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  ASSERT_LT(sock.size(), sizeof addr.sun_path);
+  std::memcpy(addr.sun_path, sock.c_str(), sock.size() + 1);
+  ASSERT_EQ(::bind(s, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  const std::string fifo = d / "fifo.png";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  struct Case {
+    std::string args, path, message;
+  };
+  std::vector<Case> cases = {
+      {"--stats " + sock, sock, "is a socket"},
+      {"--cost-image " + sock, sock, "is a socket"},
+      {"--stats " + fifo, fifo, "no process is reading"},
+      {"--cost-image " + fifo, fifo, "no process is reading"},
+      {"--checkpoint " + fifo, fifo, "no process is reading"},
+  };
+  // A block device of a major number no driver has (as root; 240-254 are for local use).
+  const std::string dead = d / "dead";
+  if (::mknod(dead.c_str(), S_IFBLK | 0600, makedev(253, 77)) == 0) {
+    const int fd = ::open(dead.c_str(), O_WRONLY | O_NONBLOCK);
+    if (fd < 0 && errno == ENXIO)
+      cases.push_back({"--stats " + dead, dead, "No such device or address"});
+    if (fd >= 0) ::close(fd);
+  }
+  for (const Case& c : cases) {
+    const CliResult r = amalgam_bounded(kLong + " --out " + (d / "x.png") + " " + c.args);
+    EXPECT_EQ(r.status, 2) << c.args << ": " << r.err;
+    EXPECT_LT(r.seconds, 5.0) << c.args << ": refused only after rendering";
+    EXPECT_NE(r.err.find(c.path + ": "), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(d / "x.png"));
+  // compare's --error-image, before the images are read.
+  ASSERT_EQ(amalgam(kSmall + " --out " + (d / "a.pfm")).status, 0);
+  for (const std::string& e : {sock, fifo}) {
+    const CliResult r =
+        amalgam_bounded("compare " + (d / "a.pfm") + " " + (d / "a.pfm") + " --error-image " + e);
+    EXPECT_EQ(r.status, 2) << e << ": " << r.err;
+    EXPECT_NE(r.err.find(e + ": "), std::string::npos) << r.err;
+  }
+  ::close(s);
+}
+
+// /dev/stdout when standard output is a pipe: its link /proc/self/fd/1 names "pipe:[N]", no
+// path; the output is written through /dev/stdout itself (it used to fail after the render,
+// "cannot open for writing").
+TEST(Outputs, DevStdoutOnAPipeIsWrittenThrough) {
+  Dir d("stdout");
+  const std::string cmd = std::string(AMALGAM_BINARY) + " " + kSmall + " --out " + (d / "x.png") +
+                          " --stats /dev/stdout 2>" + (d / "err.txt");
+  FILE* p = ::popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  std::string json;
+  char buf[4096];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) json.append(buf, n);
+  const int st = ::pclose(p);
+  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << slurp(d / "err.txt");
+  EXPECT_NE(json.find("\"tests\""), std::string::npos) << json;
 }
 
 TEST(Outputs, ASymbolicLinkKeepsPointingAtTheNewContents) {
@@ -247,6 +340,42 @@ TEST(BadInput, OneClearLineForEmptyBinaryLongOrLoopingInput) {
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.file << ": " << r.err.substr(0, 300);
     EXPECT_LT(r.err.size(), 600u) << c.file << ": the line quotes the input whole";
   }
+}
+
+// Messages say what is wrong: a --footprint out of range names the range (1e-300 used to be
+// "expected a number > 0"), a scene that is not a regular file says what it is (not "no such
+// file"), and a FIFO is never opened (it would wait for a writer).
+TEST(BadInput, MessagesSayTheRealBoundAndWhatTheFileIs) {
+  Dir d("say");
+  const std::string out = " --out " + (d / "x.png");
+  for (const char* k : {"1e-300", "1e300", "1e-31", "2e30", "0", "-1", "1e999"}) {
+    const CliResult r = amalgam(kSmall + out + " --footprint " + k);
+    EXPECT_EQ(r.status, 2) << k << ": " << r.err;
+    EXPECT_NE(r.err.find("[1e-30, 1e30]"), std::string::npos) << k << ": " << r.err;
+  }
+  for (const char* k : {"1e-30", "1e30", "0.5"})
+    EXPECT_EQ(amalgam(kSmall + out + " --footprint " + k).status, 0) << k;
+  fs::remove(d / "x.png");
+
+  fs::create_directories(d.path / "dir.json");
+  fs::create_directories(d.path / "dir");
+  ASSERT_EQ(::mkfifo((d / "fifo.json").c_str(), 0600), 0);
+  ASSERT_EQ(::mkfifo((d / "fifo.obj").c_str(), 0600), 0);
+  struct Case {
+    std::string scene, message;
+  };
+  const Case cases[] = {{d / "dir.json", "is a directory"},
+                        {d / "dir", "is a directory"},
+                        {d / "fifo.json", "is a FIFO, not a regular file"},
+                        {d / "fifo.obj", "is a FIFO, not a regular file"},
+                        {"/dev/null", "is a character device, not a regular file"}};
+  for (const Case& c : cases) {
+    const CliResult r = amalgam_bounded("render " + c.scene + out + " --quiet");
+    EXPECT_EQ(r.status, 2) << c.scene << ": " << r.err;
+    EXPECT_NE(r.err.find(c.scene + ": " + c.message), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("no such file"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(d / "x.png"));
 }
 
 TEST(BadInput, OptionsThatDoNotApplyAreRefused) {

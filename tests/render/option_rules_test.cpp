@@ -86,7 +86,8 @@ TEST(OptionRules, MessagesNameTheOptionAsTheUserSpelledIt) {
   EXPECT_EQ(message(spp, OptionSpelling::kKeywords), "spp=0: expected an integer >= 1");
   OptionRequest fp;
   fp.footprint = -2.5;
-  EXPECT_EQ(message(fp, OptionSpelling::kFlags), "--footprint -2.5: expected a number > 0");
+  EXPECT_EQ(message(fp, OptionSpelling::kFlags),
+            "--footprint -2.5: expected a number in [1e-30, 1e30]");
 }
 
 TEST(OptionRules, OptionsThatDoNotApplyAreRefused) {

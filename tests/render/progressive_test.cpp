@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
 
 #include "amalgam/io/checkpoint.h"
 #include "amalgam/load/load_scene.h"
@@ -71,6 +74,65 @@ TEST(Progressive, CorruptCheckpointIsAnInputError) {
   EXPECT_THROW(read_checkpoint(path, "x"), InputError);
   std::filesystem::remove(path);
   EXPECT_THROW(read_checkpoint(path, "x"), InputError) << "missing file";
+}
+
+/// read_checkpoint's message on the bytes of `path`, "" if it read them.
+std::string refusal(const std::string& path, const std::string& bytes) {
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out << bytes;
+  }
+  try {
+    read_checkpoint(path, "fp");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The message says what is wrong: a flipped byte in the header's magic (byte 20 is the NUL that
+// ends "AMALGAM-CHECKPOINT-5") is damage, not "format 5, this one reads format 5"; another
+// format is named; a file shorter or longer than its header declares is refused without
+// reading more than the file holds.
+TEST(Progressive, ACheckpointHeaderSaysWhatIsWrongWithIt) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("amalgam-hdr-" + std::to_string(getpid())))
+          .string();
+  FilmState st;
+  st.width = 2, st.height = 1, st.spp_done = 1;
+  st.sum.assign(2, Vec3{0.5f, 0.5f, 0.5f});
+  st.tests.assign(2, 7);
+  write_checkpoint(path, "fp", st);
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  ASSERT_EQ(refusal(path, bytes), "");
+  ASSERT_EQ(bytes.substr(0, 21), std::string("AMALGAM-CHECKPOINT-5", 21));
+
+  std::string flipped = bytes;
+  flipped[20] = static_cast<char>(flipped[20] ^ 0xff);
+  std::string m = refusal(path, flipped);
+  EXPECT_NE(m.find("damaged"), std::string::npos) << m;
+  EXPECT_EQ(m.find("this one reads format 5"), std::string::npos) << m;
+  flipped = bytes;
+  flipped[20] = '7';  // a digit: "format 57" would be made up too
+  m = refusal(path, flipped);
+  EXPECT_NE(m.find("damaged"), std::string::npos) << m;
+
+  std::string older = bytes;
+  older[19] = '4';
+  m = refusal(path, older);
+  EXPECT_NE(m.find("format 4, this one reads format 5"), std::string::npos) << m;
+
+  for (const std::string& wrong :
+       {bytes + "x", bytes.substr(0, bytes.size() - 1), bytes.substr(0, 40)}) {
+    m = refusal(path, wrong);
+    EXPECT_NE(m.find("truncated or damaged"), std::string::npos) << m;
+    EXPECT_NE(m.find(path), std::string::npos) << m;
+  }
+  std::filesystem::remove(path);
 }
 
 }  // namespace

@@ -1,10 +1,14 @@
 #include "amalgam/io/checkpoint.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <sstream>
 #include <string_view>
 #include <vector>
@@ -12,6 +16,7 @@
 #include "amalgam/math/random.h"
 #include "amalgam/util/atomic_file.h"
 #include "amalgam/util/error.h"
+#include "amalgam/util/file_kind.h"
 
 namespace amalgam {
 namespace {
@@ -83,25 +88,89 @@ void write_checkpoint(const std::string& path, const std::string& fingerprint,
 }
 
 FilmState read_checkpoint(const std::string& path, const std::string& fingerprint) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw InputError(path + ": cannot open checkpoint: " + std::strerror(errno));
-  std::string bytes{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
-  if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) {
-    if (bytes.compare(0, sizeof kMagicPrefix - 1, kMagicPrefix) == 0) {
-      std::string format;
-      for (std::size_t i = sizeof kMagicPrefix - 1;
-           i < bytes.size() && format.size() < 4 &&
-           std::isdigit(static_cast<unsigned char>(bytes[i]));
-           ++i)
-        format += bytes[i];
-      throw InputError(path + ": checkpoint of another amalgam version (format " + format +
-                       ", this one reads format 5): delete it and render again");
+  // Opened without waiting (a FIFO would wait for a writer) and refused unless a regular file:
+  // a device or a FIFO may never end, and only a file has a size to check the header against.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) throw InputError(path + ": cannot open checkpoint: " + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat info {};
+  if (::fstat(fd, &info) != 0)
+    throw InputError(path + ": cannot open checkpoint: " + std::strerror(errno));
+  if (!S_ISREG(info.st_mode))
+    throw InputError(path + ": is " + special_file_kind(info.st_mode) +
+                     ", not a checkpoint file (resume reads only a regular file amalgam wrote)");
+  const auto size = static_cast<std::uint64_t>(info.st_size);
+  // Reads `n` bytes at `offset`: false when the file ends before them.
+  const auto read_at = [&](std::uint64_t offset, void* data, std::size_t n) {
+    char* p = static_cast<char*>(data);
+    while (n > 0) {
+      const ssize_t r = ::pread(fd, p, n, static_cast<off_t>(offset));
+      if (r < 0 && errno == EINTR) continue;
+      if (r < 0) throw InputError(path + ": cannot read checkpoint: " + std::strerror(errno));
+      if (r == 0) return false;
+      p += r, offset += static_cast<std::uint64_t>(r), n -= static_cast<std::size_t>(r);
     }
-    throw InputError(path + ": not an amalgam checkpoint");
+    return true;
+  };
+
+  // The header: the magic with the format version, then the fingerprint's length.
+  char magic[sizeof kMagic] = {};
+  const bool whole_magic = read_at(0, magic, sizeof magic);
+  if (!whole_magic || std::memcmp(magic, kMagic, sizeof kMagic) != 0) {
+    const std::size_t got =
+        whole_magic ? sizeof magic : std::min<std::uint64_t>(size, sizeof magic);
+    const std::string head(magic, got);
+    if (head.compare(0, sizeof kMagicPrefix - 1, kMagicPrefix) != 0)
+      throw InputError(path + ": not an amalgam checkpoint");
+    // "AMALGAM-CHECKPOINT-<digits>\0" is a checkpoint of another format; anything else there
+    // (a flipped byte) is damage, whatever digits it starts with.
+    std::size_t i = sizeof kMagicPrefix - 1;
+    std::string format;
+    while (i < head.size() && format.size() < 4 &&
+           std::isdigit(static_cast<unsigned char>(head[i])))
+      format += head[i++];
+    if (format.empty() || format == kMagic + sizeof kMagicPrefix - 1 || i >= head.size() ||
+        head[i] != '\0')
+      throw InputError(path +
+                       ": checkpoint is damaged (its header is not that of any format): "
+                       "delete it to start over");
+    throw InputError(path + ": checkpoint of another amalgam version (format " + format +
+                     ", this one reads format 5): delete it and render again");
   }
+  // Every size the header declares is checked against the file's before it is read, so no more
+  // than the checkpoint's own bytes (the film of this render, checked by the fingerprint) are
+  // ever held.
+  const std::string short_file =
+      path + ": checkpoint is truncated or damaged (its header declares more than its " +
+      std::to_string(size) + " bytes): delete it to start over";
+  std::uint64_t fp_size = 0;
+  if (!read_at(sizeof kMagic, &fp_size, sizeof fp_size)) throw InputError(short_file);
+  if (fp_size > (1u << 20)) throw InputError(path + ": corrupt checkpoint header");
+  const std::uint64_t dims_at = sizeof kMagic + sizeof fp_size + fp_size;
+  int dims[3] = {};
+  if (!read_at(dims_at, dims, sizeof dims)) throw InputError(short_file);
+  if (dims[0] < 1 || dims[1] < 1 || static_cast<std::uint64_t>(dims[0]) * dims[1] > (1ull << 32))
+    throw InputError(path + ": corrupt checkpoint header");
+  const std::uint64_t film = static_cast<std::uint64_t>(dims[0]) * dims[1];
+  const std::uint64_t distinct_at =
+      dims_at + sizeof dims + film * (sizeof(Vec3) + sizeof(std::uint64_t) + sizeof(PixelAov)) +
+      sizeof(Counters);
+  std::uint64_t pairs = 0;
+  if (!read_at(distinct_at, &pairs, sizeof pairs)) throw InputError(short_file);
+  const std::uint64_t pairs_at = distinct_at + sizeof pairs;
+  if (pairs > (size - std::min(size, pairs_at)) / 16) throw InputError(short_file);
+  const std::uint64_t declared = pairs_at + pairs * 16 + sizeof(std::uint64_t);
+  if (declared != size)
+    throw InputError(path + ": checkpoint is truncated or damaged (its header declares " +
+                     std::to_string(declared) + " bytes, the file has " + std::to_string(size) +
+                     "): delete it to start over");
+  std::string bytes(static_cast<std::size_t>(declared), '\0');
+  if (!read_at(0, bytes.data(), bytes.size())) throw InputError(short_file);
+
   std::uint64_t stored = 0;
-  if (bytes.size() < sizeof kMagic + sizeof stored)
-    throw InputError(path + ": checkpoint is truncated");
   std::memcpy(&stored, bytes.data() + bytes.size() - sizeof stored, sizeof stored);
   bytes.resize(bytes.size() - sizeof stored);
   if (checksum(bytes) != stored)

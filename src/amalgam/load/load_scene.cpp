@@ -9,6 +9,7 @@
 #include "amalgam/io/mesh_import.h"
 #include "amalgam/scene/coordinate_limit.h"
 #include "amalgam/scene/framing.h"
+#include "amalgam/util/file_kind.h"
 
 namespace amalgam {
 
@@ -167,6 +168,9 @@ LoadedScene load_scene(const std::string& spec, const Params& params,
   const bool exists = std::filesystem::exists(spec, ec);
   if (ec) throw InputError(spec + ": " + ec.message());  // e.g. a symbolic link loop
   if (!exists) throw InputError(spec + ": no such file");
+  // Found with stat, before anything opens it: a FIFO would block the open, a device never end.
+  if (const std::string why = not_a_regular_file(spec); !why.empty())
+    throw InputError(spec + ": " + why + " (a scene is a .json or mesh file or builtin:NAME)");
   params.check_all_used();               // --set configures builtin scenes only
   return load_scene_path(spec, config);  // .json or mesh; times its own load and build
 }

@@ -1,6 +1,7 @@
 #include "amalgam/render/option_rules.h"
 
 #include <cmath>
+#include <cstdio>
 #include <initializer_list>
 #include <string_view>
 #include <tuple>
@@ -25,11 +26,11 @@ class Names {
   OptionSpelling s_;
 };
 
+/// `x` as %g writes it: 2.5, 1e-300 (not std::to_string's 0.000000).
 std::string number(double x) {
-  std::string s = std::to_string(x);
-  s.erase(s.find_last_not_of('0') + 1);
-  if (!s.empty() && s.back() == '.') s.pop_back();
-  return s;
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
 }
 
 }  // namespace
@@ -68,8 +69,9 @@ RenderOptions resolve_options(const OptionRequest& r, OptionSpelling spelling) {
 
   if (r.level && *r.level < 0)
     throw InputError(name.with("--level", std::to_string(*r.level)) + ": expected an integer >= 0");
-  if (r.footprint && !(*r.footprint > 0.0 && *r.footprint < 1e30))
-    throw InputError(name.with("--footprint", number(*r.footprint)) + ": expected a number > 0");
+  if (r.footprint && !(*r.footprint >= kMinFootprint && *r.footprint <= kMaxFootprint))
+    throw InputError(name.with("--footprint", number(*r.footprint)) +
+                     ": expected a number in [1e-30, 1e30]");
   for (const auto& [v, flag, least] :
        {std::tuple{r.width, "--width", 1}, std::tuple{r.height, "--height", 1},
         std::tuple{r.spp, "--spp", 1}, std::tuple{r.threads, "--threads", 0}})

@@ -13,6 +13,12 @@
 
 namespace amalgam {
 
+/// The range of --footprint (`footprint=`): pixels of the ray's cone, or for the volumetric
+/// renderer cone widths per cell. Held as a float and multiplied by cone widths and distances,
+/// so bounded well inside float's normal range: [1e-30, 1e30].
+inline constexpr double kMinFootprint = 1e-30;
+inline constexpr double kMaxFootprint = 1e30;
+
 /// Options as given; unset: not given (the default applies).
 struct OptionRequest {
   std::optional<std::string> renderer, opacity, order, sampler, tracer;

@@ -11,6 +11,8 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <map>
+#include <mutex>
 #include <system_error>
 
 #include "amalgam/util/fd_io.h"
@@ -41,6 +43,49 @@ void sync_directory_of(const std::string& path) {
   ::close(fd);
 }
 
+/// Descriptors of special outputs opened by check_writable, by resolved path, kept open until
+/// the output is written: opened again only then, a FIFO's reader would already have seen the
+/// end of file when the check's descriptor closed.
+std::mutex g_opened_mutex;
+std::multimap<std::string, int> g_opened;
+
+/// Opens a special target for writing without waiting (O_NONBLOCK: a FIFO with no reader gives
+/// ENXIO at once instead of blocking until one comes), then makes its writes blocking again.
+/// Returns the descriptor, or -1 with `why` set to the reason.
+int open_special(const std::string& path, std::string& why) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISSOCK(st.st_mode)) {
+    why = "is a socket, which cannot be opened as a file (write to a file, a FIFO or a device)";
+    return -1;
+  }
+  const int fd = ::open(path.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) {
+    const int err = errno;
+    if (err == ENXIO && S_ISFIFO(st.st_mode))
+      why = "is a FIFO that no process is reading (start its reader first)";
+    else
+      why = "cannot be opened for writing: " + errno_text(err);
+    return -1;
+  }
+  const int flags = ::fcntl(fd, F_GETFL);
+  if (flags >= 0) (void)::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+  return fd;
+}
+
+/// A descriptor of the special target `path` for writing: the one check_writable opened, if
+/// any (taken, so each output uses one), else a new one. -1 with `why` set on failure.
+int take_special(const std::string& path, std::string& why) {
+  {
+    const std::lock_guard<std::mutex> lock(g_opened_mutex);
+    if (const auto it = g_opened.find(path); it != g_opened.end()) {
+      const int fd = it->second;
+      g_opened.erase(it);
+      return fd;
+    }
+  }
+  return open_special(path, why);
+}
+
 }  // namespace
 
 OutputTarget resolve_output(const std::string& path) {
@@ -51,6 +96,14 @@ OutputTarget resolve_output(const std::string& path) {
     return t;
   }
   if (path.empty()) throw InputError("an output path is empty");
+  // A device, FIFO or socket is written through this very path, resolved by the kernel: also
+  // /dev/stdout, whose link /proc/self/fd/1 names a pipe as "pipe:[N]", which is no path.
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0 && !S_ISREG(info.st_mode) && !S_ISDIR(info.st_mode)) {
+    t.kind = OutputTarget::Kind::kSpecial;
+    t.path = path;
+    return t;
+  }
   fs::path p(path);
   std::error_code ec;
   for (int hops = 0; fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
@@ -91,14 +144,20 @@ std::string file_identity(const std::string& path) {
 void check_writable(const std::string& path) {
   const OutputTarget t = resolve_output(path);
   if (t.kind == OutputTarget::Kind::kStdout) return;
-  const bool exists = fs::exists(fs::path(t.path));
+  if (t.kind == OutputTarget::Kind::kSpecial) {
+    // Opened now, for real (a socket, a FIFO without a reader, a device without its hardware
+    // fail here, not after the work), and kept open for the write.
+    std::string why;
+    const int fd = open_special(t.path, why);
+    if (fd < 0) throw InputError(path + ": " + why);
+    const std::lock_guard<std::mutex> lock(g_opened_mutex);
+    g_opened.emplace(t.path, fd);
+    return;
+  }
+  // A regular file is replaced through its directory.
   const fs::path parent = fs::path(t.path).parent_path();
-  const std::string probe =
-      t.kind == OutputTarget::Kind::kSpecial || (exists && t.kind != OutputTarget::Kind::kFile)
-          ? t.path
-          : (parent.empty() ? std::string(".") : parent.string());
-  // A regular file is replaced through its directory; a special file is written through.
-  if (::access(probe.c_str(), W_OK) != 0)
+  const std::string dir = parent.empty() ? std::string(".") : parent.string();
+  if (::access(dir.c_str(), W_OK) != 0)
     throw InputError(path + ": cannot be written: " + errno_text(errno));
 }
 
@@ -161,8 +220,9 @@ void AtomicFile::commit() {
       if (!write_all(1, memory_, memory_size_))
         throw RuntimeError("write to standard output failed: " + errno_text(errno));
     } else {
-      const int fd = ::open(target_.path.c_str(), O_WRONLY | O_CLOEXEC);
-      if (fd < 0) throw RuntimeError("cannot open for writing: " + errno_text(errno));
+      std::string why;
+      const int fd = take_special(target_.path, why);
+      if (fd < 0) throw RuntimeError(why);
       const bool ok = write_all(fd, memory_, memory_size_);
       const int err = errno;
       ::close(fd);

@@ -4,10 +4,10 @@
 /// untouched or holds the complete new contents, never a half-written file.
 ///
 /// What is replaced is only ever a regular file or a new path: a symbolic link is followed and
-/// its final target replaced (the link stays); a character or block device, a FIFO or a socket
-/// (`/dev/null`, `/dev/stdout`, a pipe) is written through, never renamed over; "-" is standard
-/// output. Those are written from memory once the whole contents are made, so a failure while
-/// making them writes nothing.
+/// its final target replaced (the link stays); a character or block device or a FIFO
+/// (`/dev/null`, `/dev/stdout`, a pipe) is written through, never renamed over (a socket cannot
+/// be opened: check_writable refuses it); "-" is standard output. Those are written from memory
+/// once the whole contents are made, so a failure while making them writes nothing.
 
 #include <cstddef>
 #include <cstdio>
@@ -31,7 +31,7 @@ struct OutputTarget {
     kStdout,   ///< "-"
   };
   Kind kind = Kind::kFile;
-  std::string path;  ///< symbolic links resolved
+  std::string path;  ///< symbolic links resolved (kFile); as given (kSpecial, kStdout)
 };
 
 /// Resolves `path` (following symbolic links, at most 40) and classifies it. Throws InputError
@@ -44,8 +44,11 @@ OutputTarget resolve_output(const std::string& path);
 /// else "path P" with P the resolved directory and the name (links followed). Empty for "-".
 std::string file_identity(const std::string& path);
 
-/// Checks before any work that `path` can be written: resolve_output, then write permission
-/// on the file (or, for a new path, its directory). Throws InputError naming the path.
+/// Checks before any work that `path` can be written: resolve_output, then, for a regular file
+/// or a new path, write permission on its directory; a device or FIFO is opened for writing
+/// (without waiting: a FIFO no process is reading is refused at once, as are a socket and a
+/// device that cannot be opened) and kept open until write_atomically writes it. Throws
+/// InputError naming the path.
 void check_writable(const std::string& path);
 
 /// Removes the temporary file being written, if any, with async-signal-safe calls only: for a
