@@ -47,7 +47,7 @@ struct StopAtEveryAmalgam {
 template <Hierarchy H>
 class OracleIntegrator {
  public:
-  using Find = Traversal<H, FootprintLod, StopAtEveryAmalgam, SortedOrder, Counters>;
+  using Find = Traversal<H, ScaleSensitiveLod, StopAtEveryAmalgam, SortedOrder, Counters>;
   using Full = Integrator<H, TraditionalLod, StochasticOpacity, SortedOrder, Counters>;
 
   /// `in_amalgam` counts the samples replaced by the brute-force estimate.
@@ -55,7 +55,7 @@ class OracleIntegrator {
                    Counters& counters, std::atomic<std::uint64_t>& in_amalgam)
       : h_(&h),
         box_disc_(box_disc),
-        find_(h, FootprintLod{footprint}, counters),
+        find_(h, ScaleSensitiveLod::by_footprint(footprint), counters),
         full_(h, env, TraditionalLod{}, counters),
         k_(footprint),
         rays_(rays),

@@ -43,10 +43,10 @@ void Traditional_Uncounted(benchmark::State& s) {
   trace_image<NullCounters>(s, "7", TraditionalLod{});
 }
 void Footprint_Counted(benchmark::State& s) {
-  trace_image<Counters>(s, "10", FootprintLod{1.0f});
+  trace_image<Counters>(s, "10", ScaleSensitiveLod::by_footprint(1.0f));
 }
 void Footprint_Uncounted(benchmark::State& s) {
-  trace_image<NullCounters>(s, "10", FootprintLod{1.0f});
+  trace_image<NullCounters>(s, "10", ScaleSensitiveLod::by_footprint(1.0f));
 }
 BENCHMARK(Traditional_Counted)->Unit(benchmark::kMillisecond);
 BENCHMARK(Traditional_Uncounted)->Unit(benchmark::kMillisecond);

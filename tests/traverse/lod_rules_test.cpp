@@ -75,7 +75,7 @@ TEST(LodRules, FootprintDescendsTheAmalgamHoldingTheRayOriginAndRendersTheOthers
   const ExplicitHierarchy h = two_amalgams();
   ASSERT_NE(h.wide_nodes(), nullptr) << "the fast traversal's SIMD path";
   const NodeId right = 2;
-  const FootprintLod lod{1.0f};
+  const auto lod = ScaleSensitiveLod::by_footprint(1.0f);
   for (bool reference : {false, true}) {
     SCOPED_TRACE(reference ? "reference traversal" : "fast traversal");
     // From outside everything: the root itself is met first and rendered (opaque).
@@ -110,7 +110,7 @@ TEST(LodRules, FixedLevelRendersTheAmalgamHoldingTheRayOrigin) {
   for (bool reference : {false, true}) {
     SCOPED_TRACE(reference ? "reference traversal" : "fast traversal");
     // Level 1 (the two amalgams): a ray starting inside the right one renders it, at once.
-    const Outcome in_right = run(reference, h, FixedLevelLod{1}, wide_ray({1.5f, 0, 0}));
+    const Outcome in_right = run(reference, h, ScaleSensitiveLod::on_level(1), wide_ray({1.5f, 0, 0}));
     EXPECT_EQ(in_right.transmittance, 0.0f) << "--level never passes the level";
     ASSERT_EQ(in_right.hit.kind, TraceHit::Kind::kAmalgam);
     EXPECT_LE(in_right.hit.t, 0.0f + 1e-6f);

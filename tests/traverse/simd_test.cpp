@@ -124,9 +124,9 @@ void compare_all(const H& h, const std::vector<Ray>& rays, int levels, const std
   };
   each_opacity(TraditionalLod{}, name + " traditional");
   for (int l : {0, 1, levels / 2, levels - 2})
-    each_opacity(FixedLevelLod{l}, name + " level " + std::to_string(l));
+    each_opacity(ScaleSensitiveLod::on_level(l), name + " level " + std::to_string(l));
   for (float k : {1.0f, 8.0f})
-    each_opacity(FootprintLod{k}, name + " footprint " + std::to_string(k));
+    each_opacity(ScaleSensitiveLod::by_footprint(k), name + " footprint " + std::to_string(k));
 }
 
 std::uint32_t bits(float f) {

@@ -35,9 +35,9 @@ auto dispatch(const LoadedScene& scene, const RenderOptions& o, F&& f) {
           if (o.opacity == OpacityKind::kComposite) return with_opacity(CompositeOpacity{});
           return with_opacity(DeterministicOpacity{});
         };
-        if (const auto* l = std::get_if<OnLevel>(&o.lod)) return with_lod(FixedLevelLod{l->level});
+        if (const auto* l = std::get_if<OnLevel>(&o.lod)) return with_lod(ScaleSensitiveLod::on_level(l->level));
         if (const auto* f = std::get_if<ByFootprint>(&o.lod))
-          return with_lod(FootprintLod{f->pixels});
+          return with_lod(ScaleSensitiveLod::by_footprint(f->pixels));
         return with_lod(TraditionalLod{});  // full detail (volumetric: its other objects too)
       },
       scene.hierarchy);

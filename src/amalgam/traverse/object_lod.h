@@ -32,7 +32,7 @@ struct ObjectLod {
   bool defer_inside = false;
 
   /// Every node may be an instance root, so every node tested counts as an amalgam (as under
-  /// FootprintLod).
+  /// ScaleSensitiveLod by footprint).
   bool may_render(int) const { return true; }
   bool render(const Bbox&, int, const Ray&, float, bool) const { return false; }
 
