@@ -3,7 +3,7 @@
 /// first byte picks the file extension (byte % 6: 0 .obj, 1 .ply, 2 .gltf, 3 .glb, 4 .off,
 /// 5 .stl; the seeds use the digits '0'..'5'); the rest is the file.
 ///
-/// Run: scripts/fuzz.sh, or build-fuzz/mesh_fuzz -max_total_time=3600 fuzz/corpus/mesh
+/// Run: scripts/fuzz.sh, or build-asan/mesh_fuzz -max_total_time=3600 fuzz/corpus/mesh
 
 #include <cstddef>
 #include <cstdint>

@@ -8,7 +8,7 @@
 ///   builtin:prisms\n--set\ndepth=3\n--level\n2
 /// A SCENE that is not builtin:NAME is replaced by builtin:prisms (no file access).
 ///
-/// Run: scripts/fuzz.sh, or build-fuzz/params_fuzz -max_total_time=3600 fuzz/corpus/params
+/// Run: scripts/fuzz.sh, or build-asan/params_fuzz -max_total_time=3600 fuzz/corpus/params
 
 #include <cstddef>
 #include <cstdint>

@@ -4,7 +4,7 @@
 /// InputError.
 ///
 /// Run: scripts/fuzz.sh (short, CI) or, for a long run,
-///   build-fuzz/scene_json_fuzz -max_total_time=3600 fuzz/corpus/scene_json
+///   build-asan/scene_json_fuzz -max_total_time=3600 fuzz/corpus/scene_json
 
 #include <cstddef>
 #include <cstdint>

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages amalgam needs to build, test and plot (idempotent: does
-# nothing when they are all present).
+# nothing when they are all present). With --test, also clang-14 and its sanitizer and libFuzzer
+# runtimes, which only the sanitizer + fuzzing build (preset asan) uses.
 set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
@@ -12,6 +13,7 @@ packages=(
   pybind11-dev python3-dev python3-pytest python3-pandas
   libopenmpi-dev openmpi-bin
 )
+[ "${1:-}" = --test ] && packages+=(clang-14 libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Fuzzing: builds the libFuzzer targets (CMake preset `fuzz`, clang-14, with ASan +
-# UBSan) and runs each one for a fixed time with a fixed seed, starting from the committed seed
-# corpus in fuzz/corpus/<target>/. Fails on any crash, sanitizer report, leak, timeout or
-# out-of-memory; the offending input is kept in build-fuzz/artifacts/.
+# Fuzzing: builds the libFuzzer targets (in the sanitizer tree build-asan/: CMake preset
+# `asan`, clang-14, ASan + UBSan; build preset `fuzz` builds only them) and runs each one for
+# a fixed time with a fixed seed, starting from the committed seed corpus in
+# fuzz/corpus/<target>/. Fails on any crash, sanitizer report, leak, timeout or
+# out-of-memory; the offending input is kept in build-asan/artifacts/.
 #
 #   scripts/fuzz.sh             CI mode: a fixed number of inputs per target (deterministic:
 #                               the same inputs on any machine, about 20-40 s each)
@@ -16,27 +17,15 @@ seconds=${1:-}
 targets=(scene_json params mesh)
 declare -A runs_ci=([scene_json]=5000 [params]=6000 [mesh]=1500)
 
-# clang-14 and its libFuzzer runtime (not needed by the rest of the build, so not in deps.sh).
-missing=()
-for p in clang-14 libclang-rt-14-dev; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  echo "fuzz: installing ${missing[*]}" >&2
-  SUDO=""
-  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
-fi
-
-cmake --preset fuzz >/dev/null
-cmake --build --preset fuzz
+bash scripts/deps.sh --test  # clang-14 and its libFuzzer runtime
+cmake --preset asan >/dev/null
+cmake --build --preset fuzz  # the fuzz targets of the sanitizer tree (nothing if built)
 
 export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
-mkdir -p build-fuzz/artifacts
+mkdir -p build-asan/artifacts
 
 pids=()
 for t in "${targets[@]}"; do
@@ -44,8 +33,8 @@ for t in "${targets[@]}"; do
   dict=()
   [ -f "fuzz/$t.dict" ] && dict=("-dict=fuzz/$t.dict")
   if [ -n "$seconds" ]; then limit=("-max_total_time=$seconds"); else limit=("-runs=${runs_ci[$t]}"); fi
-  build-fuzz/${t}_fuzz -seed=1 "${limit[@]}" -timeout=20 -rss_limit_mb=2560 \
-    -print_final_stats=1 "${dict[@]}" -artifact_prefix="build-fuzz/artifacts/$t-" \
+  build-asan/${t}_fuzz -seed=1 "${limit[@]}" -timeout=20 -rss_limit_mb=2560 \
+    -print_final_stats=1 "${dict[@]}" -artifact_prefix="build-asan/artifacts/$t-" \
     "$scratch/$t" "fuzz/corpus/$t" >"$scratch/$t.log" 2>&1 &
   pids+=($!)
 done
@@ -60,9 +49,9 @@ for i in "${!targets[@]}"; do
     echo "fuzz: $t: ok, ${runs:-?} inputs (${speed:-?}/s), $cov"
   else
     status=1
-    cp "$scratch/$t.log" "build-fuzz/artifacts/$t.log"
+    cp "$scratch/$t.log" "build-asan/artifacts/$t.log"
     grep -v '^#' "$scratch/$t.log" | tail -n 60 >&2
-    echo "fuzz: $t FAILED: the input and the log are in build-fuzz/artifacts/ (add it to" \
+    echo "fuzz: $t FAILED: the input and the log are in build-asan/artifacts/ (add it to" \
       "tests/fuzz_regressions_test.cpp once fixed)" >&2
   fi
 done

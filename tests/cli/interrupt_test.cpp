@@ -24,6 +24,7 @@
 #include <utility>
 #include <vector>
 
+#include "../sanitized.h"
 #include "cli_support.h"
 
 extern char** environ;
@@ -253,7 +254,7 @@ TEST(CliInterrupt, ResumeRefusesACheckpointThatIsNotARegularFile) {
     const auto t0 = std::chrono::steady_clock::now();
     // Bounded address space (not under ASan, which reserves terabytes): a reader without end
     // runs out instead of taking the machine's memory.
-#if defined(__SANITIZE_ADDRESS__)
+#if AMALGAM_TEST_ASAN
     const std::string limit;
 #else
     const std::string limit = "ulimit -v 600000; ";

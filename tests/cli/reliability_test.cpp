@@ -25,6 +25,8 @@
 #include <string>
 #include <vector>
 
+#include "../sanitized.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -395,7 +397,7 @@ TEST(BadInput, OptionsThatDoNotApplyAreRefused) {
   EXPECT_EQ(slurp(d / "x.png"), bytes);
 }
 
-#if !defined(__SANITIZE_ADDRESS__)  // ASan reserves terabytes of address space: no ulimit -v
+#if !AMALGAM_TEST_ASAN  // ASan reserves terabytes of address space: no ulimit -v
 TEST(OutOfMemory, OneLineNamingTheWorkExitOneNoCoreDump) {
   Dir d("oom");
   {
@@ -423,7 +425,7 @@ TEST(OutOfMemory, OneLineNamingTheWorkExitOneNoCoreDump) {
 }
 #endif
 
-#if !defined(__SANITIZE_ADDRESS__)  // ASan's shadow memory is part of its resident set
+#if !AMALGAM_TEST_ASAN  // ASan's shadow memory is part of its resident set
 /// Runs amalgam with `args`; its peak resident set in bytes (wait4), -1 if it failed.
 double peak_bytes(const std::string& args) {
   const pid_t pid = fork();

@@ -22,6 +22,7 @@
 #include <tuple>
 #include <vector>
 
+#include "../sanitized.h"
 #include "amalgam/hierarchy/build/build.h"
 #include "amalgam/io/mesh_import.h"
 #include "amalgam/load/load_scene.h"
@@ -31,17 +32,7 @@ namespace amalgam {
 namespace {
 
 // The ASan/UBSan preset runs this file too, about 10x slower: fewer rays there.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr int kRayScale = 10;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr int kRayScale = 10;
-#else
-constexpr int kRayScale = 1;
-#endif
-#else
-constexpr int kRayScale = 1;
-#endif
+constexpr int kRayScale = kSanitized ? 10 : 1;
 
 // -------------------------------------------------------------------------------------------
 // Indexed meshes with exactly shared vertices.

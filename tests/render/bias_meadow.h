@@ -7,19 +7,9 @@
 
 #include <string>
 
-namespace amalgam {
+#include "../sanitized.h"
 
-#if defined(__SANITIZE_ADDRESS__)
-inline constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-inline constexpr bool kSanitized = true;
-#else
-inline constexpr bool kSanitized = false;
-#endif
-#else
-inline constexpr bool kSanitized = false;
-#endif
+namespace amalgam {
 
 inline const std::string kScene = std::string(AMALGAM_SOURCE_DIR) + "/tests/data/bias-meadow.json";
 inline const std::string kReference =

@@ -94,8 +94,8 @@ TEST(Isa, Avx2CopyGivesThePortableBits) {
 
 #endif
 
-TEST(Isa, GccBuildsForX86HoldTheAvx2Copy) {
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+TEST(Isa, GccAndClangBuildsForX86HoldTheAvx2Copy) {
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
   EXPECT_TRUE(simd_avx2_built());
 #else
   EXPECT_FALSE(simd_avx2_built());

@@ -1,6 +1,6 @@
 // The AVX2 copy's triangle kernel for simd_test.cpp, compiled as render/render_avx2.cpp
 // compiles the library's AVX2 copy: the lower layers first, for the baseline, then the hot-path
-// header under GCC's target pragma, in the inline namespace isa_avx2.
+// header between AMALGAM_AVX2_BEGIN and _END (util/isa.h), in the inline namespace isa_avx2.
 #include "avx2_kernels.h"
 
 #if defined(AMALGAM_BUILD_AVX2_COPY)
@@ -10,9 +10,9 @@
 
 #include "amalgam/geometry/intersect.h"
 #include "amalgam/geometry/wide.h"
+#include "amalgam/util/isa.h"
 
-#pragma GCC push_options
-#pragma GCC target("avx2")
+AMALGAM_AVX2_BEGIN
 #include "amalgam/geometry/wide_kernels.h"
 
 namespace amalgam::test {
@@ -35,6 +35,6 @@ unsigned avx2_box_test8(BoxRows b, const Ray& ray, int n, float t_entry[8], bool
 }
 
 }  // namespace amalgam::test
-#pragma GCC pop_options
+AMALGAM_AVX2_END
 
 #endif

@@ -1,10 +1,10 @@
 // The AVX2 copy of the hot paths (util/isa.h). Everything below the traversal is included
-// first, compiled for the baseline like the rest of the library; then GCC's target pragma
-// compiles the traversal, its kernels, the integrator and the pass loop for AVX2, in the
-// inline namespace isa_avx2 (AMALGAM_ISA_AVX2), so no symbol is shared with the portable copy.
-// Every header included after the pragma must be one of those ISA-namespaced hot-path headers:
-// a lower header first included there would give an AVX2 body to a function of the portable
-// library.
+// first, compiled for the baseline like the rest of the library; then AMALGAM_AVX2_BEGIN (a
+// target pragma, util/isa.h) compiles the traversal, its kernels, the integrator and the pass
+// loop for AVX2, in the inline namespace isa_avx2 (AMALGAM_ISA_AVX2), so no symbol is shared
+// with the portable copy. Every header included after AMALGAM_AVX2_BEGIN must be one of those
+// ISA-namespaced hot-path headers: a lower header first included there would give an AVX2 body
+// to a function of the portable library.
 #if defined(AMALGAM_BUILD_AVX2_COPY)
 #define AMALGAM_ISA_AVX2 1  // before any include: util/isa.h reads it once
 
@@ -42,10 +42,10 @@
 #include "amalgam/traverse/lod.h"
 #include "amalgam/traverse/opacity.h"
 #include "amalgam/traverse/order.h"
+#include "amalgam/util/isa.h"
 
-#pragma GCC push_options
-#pragma GCC target("avx2")
+AMALGAM_AVX2_BEGIN
 #include "amalgam/render/render_isa.inl"
-#pragma GCC pop_options
+AMALGAM_AVX2_END
 
 #endif
