@@ -10,7 +10,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh
 cmake --preset release >/dev/null
-cmake --build --preset release
+cmake --build --preset release --target amalgam  # the CLI and its import helper only
 out=out/demo
 mkdir -p "$out"
 size=(--width 480 --height 360 --spp 4)
