@@ -24,7 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 const fs::path kGltf = "/usr/share/assimp/models/glTF2";
 
-#define REQUIRE_MODELS()               \
+#define REQUIRE_GLTF_MODELS()               \
   ASSERT_TRUE(fs::is_directory(kGltf)) \
       << kGltf << " is missing: install Debian's assimp-testmodels package (scripts/deps.sh)"
 
@@ -229,7 +229,7 @@ TEST(Texture, CopiesOfATexturedTriangleBakeItsColourAndOthersTheirOwn) {
 }
 
 TEST(Texture, BoxTexturedImportsItsTextureAndEveryVariantTheSameImage) {
-  REQUIRE_MODELS();
+  REQUIRE_GLTF_MODELS();
   const ImportedMesh plain = import_mesh((kGltf / "BoxTextured-glTF/BoxTextured.gltf").string());
   const ImportedMesh embedded =
       import_mesh((kGltf / "BoxTextured-glTF-Embedded/BoxTextured.gltf").string());
@@ -264,7 +264,7 @@ TEST(Texture, BoxTexturedImportsItsTextureAndEveryVariantTheSameImage) {
 }
 
 TEST(Texture, TexturesAreInTheContentHash) {
-  REQUIRE_MODELS();
+  REQUIRE_GLTF_MODELS();
   const std::string path = (kGltf / "BoxTextured-glTF-Embedded/BoxTextured.gltf").string();
   SceneDescription d = mesh_scene(path);
   SceneDescription changed = d;
@@ -282,7 +282,7 @@ TEST(Texture, TexturesAreInTheContentHash) {
 }
 
 TEST(Texture, ObjDiffuseMapsWithWindowsPathsAreRead) {
-  REQUIRE_MODELS();
+  REQUIRE_GLTF_MODELS();
   const ImportedMesh m = import_mesh("/usr/share/assimp/models/OBJ/spider.obj");
   EXPECT_EQ(m.textures.size(), 5u);  // map_Kd .\name.jpg, five JPEG files
   EXPECT_EQ(m.uvs.size(), m.triangles.size());
@@ -308,7 +308,7 @@ void write(const fs::path& p, const std::string& text) {
 }
 
 TEST(Texture, AMissingTextureIsOneWarningAndTheBaseColour) {
-  REQUIRE_MODELS();
+  REQUIRE_GLTF_MODELS();
   const fs::path d = scratch_dir() / "missing";
   fs::create_directories(d);
   fs::copy_file(kGltf / "BoxTextured-glTF/BoxTextured.gltf", d / "BoxTextured.gltf");
@@ -328,7 +328,7 @@ TEST(Texture, AMissingTextureIsOneWarningAndTheBaseColour) {
 }
 
 TEST(Texture, ObjCorruptJpegAndMissingCoordinatesWarnAndRender) {
-  REQUIRE_MODELS();
+  REQUIRE_GLTF_MODELS();
   const fs::path d = scratch_dir() / "obj";
   fs::create_directories(d);
   write(d / "m.mtl", "newmtl bad\nKd 0.5 0.25 1\nmap_Kd bad.jpg\nnewmtl good\nmap_Kd good.jpg\n");
@@ -355,7 +355,7 @@ TEST(Texture, ObjCorruptJpegAndMissingCoordinatesWarnAndRender) {
 }
 
 TEST(GltfCamera, TheFirstPerspectiveCameraAsTheFileGivesIt) {
-  REQUIRE_MODELS();
+  REQUIRE_GLTF_MODELS();
   const std::string path = (kGltf / "cameras/Cameras.gltf").string();
   const SceneDescription d = mesh_scene(path);
   ASSERT_EQ(d.cameras.size(), 1u);  // the second is orthographic
@@ -372,7 +372,7 @@ TEST(GltfCamera, TheFirstPerspectiveCameraAsTheFileGivesIt) {
 }
 
 TEST(GltfCamera, ChooseCameraByNameIndexAndOverride) {
-  REQUIRE_MODELS();
+  REQUIRE_GLTF_MODELS();
   LoadedScene s = load_scene_path((kGltf / "cameras/Cameras.gltf").string());
   const Camera file = s.env.camera;
   const std::uint64_t h0 = content_hash(s);
@@ -400,7 +400,7 @@ TEST(GltfCamera, ChooseCameraByNameIndexAndOverride) {
 }
 
 TEST(GltfCamera, DefaultLightsFollowAChosenView) {
-  REQUIRE_MODELS();
+  REQUIRE_GLTF_MODELS();
   LoadedScene s = load_scene_path((kGltf / "BoxTextured-glTF-Embedded/BoxTextured.gltf").string());
   ASSERT_TRUE(s.default_lights);
   EXPECT_THROW(choose_camera(s, {"0", {}, {}, {}, {}}), InputError);  // the file has none
@@ -455,7 +455,7 @@ TEST(GltfLights, PointAndDirectionalLightsInTheSceneUnits) {
 }
 
 TEST(GltfLights, SkinsAndAnimationsWarnOnceEach) {
-  REQUIRE_MODELS();
+  REQUIRE_GLTF_MODELS();
   const SceneDescription d = mesh_scene((kGltf / "simple_skin/simple_skin.gltf").string());
   ASSERT_EQ(d.warnings.size(), 2u);
   const auto has = [&](const char* what) {
