@@ -22,6 +22,7 @@
 #include "cli_support.h"
 
 namespace {
+namespace cli {  // per file: the tests are compiled in batches
 
 namespace fs = std::filesystem;
 
@@ -351,9 +352,11 @@ TEST(Cli, AWriteFailingHalfWayLeavesThePreviousFileIntact) {
   fs::remove_all(d);
 }
 
+}  // namespace cli
 }  // namespace
 
 namespace {
+namespace cli {  // per file: the tests are compiled in batches
 
 TEST(CliLimits, MaxMemoryFailsEarlyWithAClearMessage) {
   const std::string err = (temp_dir() / "mem.txt").string();
@@ -460,4 +463,5 @@ TEST(CliLimits, ProgressBarOnlyOnATerminal) {
   fs::remove_all(d);
 }
 
+}  // namespace cli
 }  // namespace

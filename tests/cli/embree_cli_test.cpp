@@ -22,6 +22,7 @@
 #include "cli_support.h"
 
 namespace {
+namespace embree_cli {  // per file: the tests are compiled in batches
 
 namespace fs = std::filesystem;
 
@@ -120,4 +121,5 @@ TEST(CliEmbree, ABuildWithoutEmbreeSaysSo) {
 }
 #endif
 
+}  // namespace embree_cli
 }  // namespace

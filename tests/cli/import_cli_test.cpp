@@ -19,6 +19,7 @@
 #include "cli_support.h"
 
 namespace {
+namespace import_cli {  // per file: the tests are compiled in batches
 
 namespace fs = std::filesystem;
 const fs::path kGltf = "/usr/share/assimp/models/glTF2";
@@ -178,4 +179,5 @@ TEST(SceneImportCli, CameraErrorsAreInputErrors) {
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
+}  // namespace import_cli
 }  // namespace

@@ -30,6 +30,7 @@
 extern char** environ;
 
 namespace {
+namespace interrupt {  // per file: the tests are compiled in batches
 
 namespace fs = std::filesystem;
 using amalgam::test::samples_held;
@@ -384,4 +385,5 @@ TEST(CliInterrupt, EmbreeResumesItsOwnCheckpointButNotAmalgams) {
 }
 #endif
 
+}  // namespace interrupt
 }  // namespace

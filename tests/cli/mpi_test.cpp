@@ -27,6 +27,7 @@
 extern char** environ;
 
 namespace {
+namespace mpi_cli {  // per file: the tests are compiled in batches
 
 namespace fs = std::filesystem;
 using amalgam::test::run_command;
@@ -372,4 +373,5 @@ TEST(CliMpi, ExperimentSweepsOverThreeRanksGiveTheResultsOfOneProcess) {
   EXPECT_TRUE(fs::exists(d.path / "three" / "report.md"));
 }
 
+}  // namespace mpi_cli
 }  // namespace

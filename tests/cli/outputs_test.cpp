@@ -33,6 +33,7 @@
 #include "cli_support.h"
 
 namespace {
+namespace outputs {  // per file: the tests are compiled in batches
 
 namespace fs = std::filesystem;
 
@@ -336,4 +337,5 @@ TEST(RenderOutputs, LevelPngIsColourCodedWithItsLegendPrinted) {
   EXPECT_GT(black, 0);
 }
 
+}  // namespace outputs
 }  // namespace

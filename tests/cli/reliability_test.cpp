@@ -28,6 +28,7 @@
 #include "../sanitized.h"
 
 namespace {
+namespace reliability {  // per file: the tests are compiled in batches
 
 namespace fs = std::filesystem;
 
@@ -470,4 +471,5 @@ TEST(MaxMemory, EstimatedBeforeBuildingWithin25PercentOfThePeak) {
 }
 #endif
 
+}  // namespace reliability
 }  // namespace
