@@ -3,11 +3,6 @@
 /// runs it with amalgam's Integrator over a hierarchy; bench/field_bench.cpp runs it with the
 /// same Integrator over Intel Embree, so both images come from one loop and one sampling.
 
-#include <oneapi/tbb/blocked_range2d.h>
-#include <oneapi/tbb/enumerable_thread_specific.h>
-#include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/task_arena.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
@@ -17,6 +12,7 @@
 #include "amalgam/math/random.h"
 #include "amalgam/math/sobol.h"
 #include "amalgam/render/integrator.h"
+#include "amalgam/render/pass_blocks.h"
 #include "amalgam/render/render.h"
 #include "amalgam/util/isa.h"
 
@@ -85,18 +81,28 @@ inline void render_pixel(const Camera& camera, const RenderOptions& o, int x, in
 /// (kStratified), a function of (o.seed, pixel, s) too. `make(counters)` returns an integrator for
 /// one tile (an object with `li(ray, key)` returning a SampleResult) that counts its tests into
 /// `counters`. Returns whether control.cancel stopped the render early.
+/// The block body of a pass over `Body`, as run_pass_blocks takes it.
+template <class Body>
+void call_pass_block(void* body, int y0, int y1, int x0, int x1, Counters& counters,
+                     CostDistribution& per_primary) {
+  (*static_cast<Body*>(body))(y0, y1, x0, x1, counters, per_primary);
+}
+
+/// Adds samples st.spp_done .. o.spp - 1 to `st` (sized for o.width x o.height), in passes of
+/// whole samples per pixel over 8x8 tiles on o.threads threads (0: all). Pixel (x, y),
+/// sample s uses the random stream hash(o.seed, y * width + x, s), so the result does not
+/// depend on the thread count. Its position in the pixel comes from that stream
+/// (PixelSampler::kIndependent) or is point s of the pixel's scrambled Sobol sequence
+/// (kStratified), a function of (o.seed, pixel, s) too. `make(counters)` returns an integrator for
+/// one tile (an object with `li(ray, key)` returning a SampleResult) that counts its tests into
+/// `counters`. Returns whether control.cancel stopped the render early.
 template <class MakeIntegrator>
 bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
                    const RenderControl& control, MakeIntegrator&& make) {
-  struct ThreadState {
-    Counters counters;
-    CostDistribution per_primary;
-  };
   const std::size_t pixels = static_cast<std::size_t>(o.width) * o.height;
   // Samples per pass: whole samples for every pixel, about 2^16 primary rays per pass so that
   // small images do not pay for many passes and large ones can stop quickly.
   const int per_pass = samples_per_pass(pixels);
-  tbb::task_arena arena(render_threads(o));
   std::vector<Vec3> pass_sum;
   std::vector<std::uint64_t> pass_tests;
   std::vector<PixelAov> pass_aov;
@@ -106,35 +112,27 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
     pass_sum = st.sum;  // continue each pixel's running sum in sample order
     pass_tests = st.tests;
     pass_aov = st.aov;
-    tbb::enumerable_thread_specific<ThreadState> states;
-    std::atomic<bool> stopped{false};
-    arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range2d<int>(0, o.height, 8, 0, o.width, 8),
-                        [&](const tbb::blocked_range2d<int>& r) {
-                          if (control.cancel && control.cancel->load(std::memory_order_relaxed)) {
-                            stopped.store(true, std::memory_order_relaxed);
-                            return;
-                          }
-                          ThreadState& ts = states.local();
-                          auto integrator = make(ts.counters);
-                          for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
-                            for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
-                              const std::size_t pix = static_cast<std::size_t>(y) * o.width + x;
-                              render_pixel(camera, o, x, y, s0, s1, integrator, ts.counters,
-                                           ts.per_primary, pass_sum[pix], pass_tests[pix],
-                                           pass_aov[pix]);
-                            }
-                          }
-                        });
-    });
-    if (stopped.load()) return true;  // the pass is incomplete: discard it
+    auto body = [&](int y0, int y1, int x0, int x1, Counters& counters,
+                    CostDistribution& per_primary) {
+      auto integrator = make(counters);
+      for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) {
+          const std::size_t pix = static_cast<std::size_t>(y) * o.width + x;
+          render_pixel(camera, o, x, y, s0, s1, integrator, counters, per_primary, pass_sum[pix],
+                       pass_tests[pix], pass_aov[pix]);
+        }
+      }
+    };
+    Counters counters;
+    CostDistribution per_primary;
+    if (run_pass_blocks(render_threads(o), 0, o.height, 0, o.width, control.cancel,
+                        &call_pass_block<decltype(body)>, &body, counters, per_primary))
+      return true;  // the pass is incomplete: discard it
     st.sum.swap(pass_sum);
     st.tests.swap(pass_tests);
     st.aov.swap(pass_aov);
-    for (const ThreadState& ts : states) {
-      st.counters.merge(ts.counters);
-      st.per_primary.merge(ts.per_primary);
-    }
+    st.counters.merge(counters);
+    st.per_primary.merge(per_primary);
     st.spp_done = s1;
     if (control.on_pass) control.on_pass(st);
     if (control.cancel && control.cancel->load() && st.spp_done < o.spp) return true;
@@ -150,39 +148,20 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
 template <class MakeIntegrator>
 bool render_tile_passes(const Camera& camera, const RenderOptions& o, FilmTile& tile, int s0,
                         int s1, const std::atomic<bool>* cancel, MakeIntegrator&& make) {
-  struct ThreadState {
-    Counters counters;
-    CostDistribution per_primary;
-  };
   const TileRect& t = tile.rect;
-  tbb::task_arena arena(render_threads(o));
-  tbb::enumerable_thread_specific<ThreadState> states;
-  std::atomic<bool> stopped{false};
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range2d<int>(t.y0, t.y1, 8, t.x0, t.x1, 8),
-                      [&](const tbb::blocked_range2d<int>& r) {
-                        if (cancel && cancel->load(std::memory_order_relaxed)) {
-                          stopped.store(true, std::memory_order_relaxed);
-                          return;
-                        }
-                        ThreadState& ts = states.local();
-                        auto integrator = make(ts.counters);
-                        for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
-                          for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
-                            const std::size_t i =
-                                static_cast<std::size_t>(y - t.y0) * (t.x1 - t.x0) + (x - t.x0);
-                            render_pixel(camera, o, x, y, s0, s1, integrator, ts.counters,
-                                         ts.per_primary, tile.sum[i], tile.tests[i], tile.aov[i]);
-                          }
-                        }
-                      });
-  });
-  if (stopped.load()) return true;
-  for (const ThreadState& ts : states) {
-    tile.counters.merge(ts.counters);
-    tile.per_primary.merge(ts.per_primary);
-  }
-  return false;
+  auto body = [&](int y0, int y1, int x0, int x1, Counters& counters,
+                  CostDistribution& per_primary) {
+    auto integrator = make(counters);
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y - t.y0) * (t.x1 - t.x0) + (x - t.x0);
+        render_pixel(camera, o, x, y, s0, s1, integrator, counters, per_primary, tile.sum[i],
+                     tile.tests[i], tile.aov[i]);
+      }
+    }
+  };
+  return run_pass_blocks(render_threads(o), t.y0, t.y1, t.x0, t.x1, cancel,
+                         &call_pass_block<decltype(body)>, &body, tile.counters, tile.per_primary);
 }
 
 AMALGAM_ISA_END

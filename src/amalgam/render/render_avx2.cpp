@@ -35,6 +35,7 @@
 #include "amalgam/hierarchy/wide.h"
 #include "amalgam/math/random.h"
 #include "amalgam/render/loaded_scene.h"
+#include "amalgam/render/pass_blocks.h"
 #include "amalgam/render/render.h"
 #include "amalgam/render/render_isa.h"
 #include "amalgam/stats/counters.h"
