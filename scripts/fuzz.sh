@@ -6,7 +6,7 @@
 # out-of-memory; the offending input is kept in build-asan/artifacts/.
 #
 #   scripts/fuzz.sh             CI mode: a fixed number of inputs per target (deterministic:
-#                               the same inputs on any machine, about 20-40 s each)
+#                               the same inputs on any machine; docs/testing.md has the time)
 #   scripts/fuzz.sh SECONDS     SECONDS per target instead; the targets run side by side
 #
 # New inputs found during the run go to a scratch directory and are thrown away, so the
