@@ -22,8 +22,8 @@ struct TraditionalLod {
 /// `pixels` times the width of the ray's cone where the ray enters it. An amalgam that contains
 /// the ray's origin (a shadow ray leaving a surface inside it) is descended instead: its opacity
 /// describes rays that cross it, not rays that start within it.
-/// One type for both rules (the choice is one well-predicted branch per amalgam met) halves the
-/// traversals the renderer instantiates, and with them its compile time.
+/// One type for both rules (the choice is one well-predicted branch per amalgam met) nearly halves
+/// the traversals the renderer instantiates (72 to 40 per instruction set), and its compile time.
 struct ScaleSensitiveLod {
   int level = -1;
   float pixels = 1.0f;
