@@ -73,14 +73,6 @@ inline void render_pixel(const Camera& camera, const RenderOptions& o, int x, in
   aov_io = aov;
 }
 
-/// Adds samples st.spp_done .. o.spp - 1 to `st` (sized for o.width x o.height), in passes of
-/// whole samples per pixel over 8x8 tiles on o.threads threads (0: all). Pixel (x, y),
-/// sample s uses the random stream hash(o.seed, y * width + x, s), so the result does not
-/// depend on the thread count. Its position in the pixel comes from that stream
-/// (PixelSampler::kIndependent) or is point s of the pixel's scrambled Sobol sequence
-/// (kStratified), a function of (o.seed, pixel, s) too. `make(counters)` returns an integrator for
-/// one tile (an object with `li(ray, key)` returning a SampleResult) that counts its tests into
-/// `counters`. Returns whether control.cancel stopped the render early.
 /// The block body of a pass over `Body`, as run_pass_blocks takes it.
 template <class Body>
 void call_pass_block(void* body, int y0, int y1, int x0, int x1, Counters& counters,
