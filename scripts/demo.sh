@@ -8,8 +8,10 @@
 # rendered at each pixel. Traditional cost grows with the scene; scale-sensitive cost does not.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/deps.sh
-cmake --preset release >/dev/null
+bash scripts/deps.sh --demo  # the CLI's packages only; scripts/test.sh installs the rest
+# No tests or benchmarks here (their libraries are not installed yet); scripts/test.sh turns
+# them on in the same tree, whose objects it then reuses.
+cmake --preset release -DAMALGAM_BUILD_TESTS=OFF -DAMALGAM_BUILD_BENCH=OFF >/dev/null
 cmake --build --preset release --target amalgam  # the CLI and its import helper only
 out=out/demo
 mkdir -p "$out"

@@ -4,8 +4,9 @@
 #   scripts/test.sh          the release suite; the same suite under ASan + UBSan (clang), but
 #                            for the few tests that take longest there; a short fixed-seed run
 #                            of every fuzz target (built in the same sanitizer tree)
-#   scripts/test.sh --long   what the first leaves out: those long tests under ASan + UBSan
-#                            (.ci/run runs both, so every test runs under the sanitizers in CI)
+#   scripts/test.sh --long   what the first leaves out: those long tests under ASan + UBSan,
+#                            and a longer run of the slowest fuzz target (.ci/run runs both, so
+#                            every test runs under the sanitizers in CI)
 #
 # Each stage prints its wall-clock time; with AMALGAM_TEST_TIMES=FILE it is also appended to
 # FILE as "stage<TAB>seconds" (scripts/test_times.py turns that into docs/testing.md's table).
@@ -37,10 +38,14 @@ if ((long)); then
   stage "asan: configure" cmake --preset asan >/dev/null
   stage "asan: build" cmake --build --preset asan
   stage "asan: long tests" ctest --preset asan-long
+  stage "fuzz: long run" bash scripts/fuzz.sh --long
   exit 0
 fi
 
-stage "release: configure" cmake --preset release >/dev/null
+# Every part on, whatever an earlier configure of build/ left in its cache (scripts/demo.sh
+# configures it without tests and benchmarks, before their packages are installed).
+stage "release: configure" cmake --preset release -DAMALGAM_BUILD_TESTS=ON \
+  -DAMALGAM_BUILD_BENCH=ON -DAMALGAM_PYTHON=ON -DAMALGAM_MPI=ON >/dev/null
 stage "release: build" cmake --build --preset release
 stage "release: tests" ctest --preset release
 
