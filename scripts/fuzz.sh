@@ -7,6 +7,9 @@
 #
 #   scripts/fuzz.sh             CI mode: a fixed number of inputs per target (deterministic:
 #                               the same inputs on any machine; docs/testing.md has the time)
+#   scripts/fuzz.sh --long      the slow target (mesh: every input starts the import helper)
+#                               with more inputs: the same seed, so a superset of the above
+#                               (scripts/test.sh --long)
 #   scripts/fuzz.sh SECONDS     SECONDS per target instead; the targets run side by side
 #
 # New inputs found during the run go to a scratch directory and are thrown away, so the
@@ -15,7 +18,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-}
 targets=(scene_json params mesh)
-declare -A runs_ci=([scene_json]=5000 [params]=6000 [mesh]=1500)
+declare -A runs_ci=([scene_json]=5000 [params]=6000 [mesh]=400)
+if [ "$seconds" = --long ]; then
+  seconds=""
+  targets=(mesh)
+  runs_ci=([mesh]=1500)
+fi
 
 bash scripts/deps.sh --test  # clang-14 and its libFuzzer runtime
 cmake --preset asan >/dev/null

@@ -11,5 +11,9 @@ set(AMALGAM_LONG_TESTS
   ExperimentCli.OutWritesCsvPlotAndReportForEveryExperiment
   Experiments.EveryCheckBearsOnAListedStatement
   CliLimits.ProgressBarOnlyOnATerminal
+  Embree.EveryExampleSceneMatchesTheTraditionalRenderer
+  Volumetric.CorrelationFitGivesTheCoverage
+  VolumeCells.CoverageAlongLinesMatchesTheHitProbability
+  Experiments.ExpectedMatchesEq9AndRefutesPrintedEq12
 )
 set_tests_properties(${AMALGAM_LONG_TESTS} PROPERTIES LABELS long)
