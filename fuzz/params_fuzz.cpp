@@ -10,6 +10,7 @@
 ///
 /// Run: scripts/fuzz.sh, or build-asan/params_fuzz -max_total_time=3600 fuzz/corpus/params
 
+#include <CLI/CLI.hpp>
 #include <cstddef>
 #include <cstdint>
 #include <string>

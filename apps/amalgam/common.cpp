@@ -1,5 +1,6 @@
 #include "common.h"
 
+#include <CLI/CLI.hpp>
 #include <cctype>
 #include <charconv>
 #include <cmath>

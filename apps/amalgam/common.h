@@ -1,7 +1,7 @@
 #pragma once
 /// \file Options shared by the subcommands, and the error-to-exit-status rule.
 
-#include <CLI/CLI.hpp>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -9,6 +9,15 @@
 #include "amalgam/load/load_scene.h"
 #include "amalgam/math/vec.h"
 #include "amalgam/render/options.h"
+
+// Declared, not included: CLI11's header costs about 8 s of compile time at -O3 in every file
+// that includes it (it defines its validators in each), and only the files that build the
+// command line need it (main.cpp, common.cpp).
+namespace CLI {
+class App;
+class Option;
+class Validator;
+}  // namespace CLI
 
 namespace amalgam::cli {
 
