@@ -180,10 +180,18 @@ LogRange parse_cost_range(const std::string& text) {
   return {v[0], v[1]};
 }
 
-/// The command line as one string, each argument that needs it in single quotes.
+/// The command line as one string, each argument that needs it in single quotes, without
+/// --threads: it goes into the EXR header, which is part of the file's bytes, and those are the
+/// same for any thread count (the stats hold the threads used).
 std::string command_text(const std::vector<std::string>& argv) {
   std::string out;
-  for (const std::string& a : argv) {
+  for (std::size_t i = 0; i < argv.size(); ++i) {
+    const std::string& a = argv[i];
+    if (i > 0 && a == "--threads") {
+      ++i;  // and its value
+      continue;
+    }
+    if (a.starts_with("--threads=")) continue;
     if (!out.empty()) out += ' ';
     const bool plain = !a.empty() && a.find_first_not_of(
                                          "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMN"
@@ -209,7 +217,7 @@ std::string options_text(const CommonOptions& c, int spp) {
   else if (o.renderer() != RendererKind::kTraditional)
     f << " --footprint " << footprint_of(o.lod);
   f << " --seed " << o.seed << " --width " << o.width << " --height " << o.height << " --spp "
-    << spp << " --threads " << render_threads(o);
+    << spp;
   return f.str();
 }
 

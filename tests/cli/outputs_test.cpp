@@ -143,6 +143,35 @@ TEST(RenderOutputs, ExrHasEveryLayerInFloat32AndTheCostAddsUpToTheStats) {
     EXPECT_EQ(levels[i].x, ch.at("level.Y")[i]) << "pixel " << i;
 }
 
+// Same seed, same bytes, any thread count: the EXR header records the command and the options
+// without --threads (the stats JSON holds the threads used), so the whole file is the same.
+TEST(RenderOutputs, ExrBytesAreTheSameForAnyThreadCount) {
+  const fs::path d = temp_dir() / "exr-threads";
+  fs::create_directories(d);
+  const std::string out = (d / "a.exr").string();
+  std::string first;
+  for (const char* threads : {"--threads 1", "--threads=2", "--threads 3"}) {
+    SCOPED_TRACE(threads);
+    ASSERT_EQ(amalgam(kRender + threads + " --out " + out).status, 0);
+    const std::string bytes = slurp(out);
+    if (first.empty()) {
+      first = bytes;
+      Imf::Header header;
+      int w = 0, h = 0;
+      (void)read_channels(out, w, h, &header);
+      const std::string command =
+          header.typedAttribute<Imf::StringAttribute>("amalgam:command").value();
+      EXPECT_EQ(command.find("--threads"), std::string::npos) << command;
+      EXPECT_NE(command.find("--seed 7"), std::string::npos) << command;
+      EXPECT_EQ(
+          header.typedAttribute<Imf::StringAttribute>("amalgam:options").value().find("threads"),
+          std::string::npos);
+    } else {
+      EXPECT_TRUE(bytes == first) << "the file differs from the one rendered with 1 thread";
+    }
+  }
+}
+
 // Totals above 2048 per pixel (where half floats round) are exact in the float32 cost layer.
 TEST(RenderOutputs, ExrCostIsExactBeyondHalfPrecision) {
   const fs::path d = temp_dir() / "exact";
