@@ -10,6 +10,7 @@
 
 #include "amalgam/render/option_rules.h"
 #include "amalgam/render/tracer.h"
+#include "amalgam/scene/coordinate_limit.h"
 
 namespace amalgam::cli {
 
@@ -154,6 +155,23 @@ const CLI::Validator& non_negative_int() {
   return v;
 }
 
+CLI::Validator seconds_in(double lo, double hi, const std::string& range) {
+  return CLI::Validator(
+      [lo, hi, range](std::string& v) -> std::string {
+        double x = NAN;
+        std::size_t end = 0;
+        try {
+          x = std::stod(v, &end);
+        } catch (const std::exception&) {
+          end = 0;
+        }
+        // NaN fails both comparisons: refused like any other value outside the range.
+        if (!v.empty() && end == v.size() && x >= lo && x <= hi) return "";
+        return "expected seconds in " + range;
+      },
+      "SECONDS");
+}
+
 std::uint64_t parse_seed(const std::string& text) {
   std::uint64_t x = 0;
   const char* b = text.data();
@@ -194,6 +212,13 @@ Vec3 parse_vec3(const std::string& text, const std::string& option) {
   if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() ||
       !is_finite(v))
     throw InputError(option + " '" + text + "': expected three numbers x,y,z");
+  // The range scene files and meshes are held to (scene/coordinate_limit.h): beyond it the
+  // triangle test overflows float and the image would be silently empty.
+  for (const float c : {v.x, v.y, v.z})
+    if (std::abs(static_cast<double>(c)) > kMaxCoordinate)
+      throw InputError(option + " '" + text +
+                       "': each coordinate must be within [-1e12, 1e12], the range of scene "
+                       "coordinates");
   return v;
 }
 

@@ -58,6 +58,9 @@ struct CommonOptions {
 /// with 6 decimals: 390 characters for "positive").
 const CLI::Validator& positive_int();
 const CLI::Validator& non_negative_int();
+/// A number of seconds in [lo, hi] (`range` is how the message writes it); NaN, infinities and
+/// trailing text are refused.
+CLI::Validator seconds_in(double lo, double hi, const std::string& range);
 
 /// "--seed TEXT" as an unsigned 64-bit integer; throws InputError with the allowed range for
 /// anything else (a sign, an exponent, a fraction, 2^64 or more).
@@ -76,7 +79,8 @@ const std::string& activity();
 /// ("amalgam: warning: ...").
 void print_warnings(const LoadedScene& scene);
 
-/// Parses "x,y,z" into three floats; throws InputError naming the option.
+/// Parses "x,y,z" into three floats, each within the range of scene coordinates (+-1e12);
+/// throws InputError naming the option.
 Vec3 parse_vec3(const std::string& text, const std::string& option);
 
 /// The options of `render` beyond the shared ones.
@@ -87,7 +91,8 @@ struct RenderExtras {
   std::vector<std::string> argv;  ///< the whole command line, for the stats and EXR header
   bool resume = false;
   bool quiet = false;
-  std::string max_memory;          ///< as given (parse_bytes); empty: the machine's physical memory
+  std::string max_memory;          ///< as given (parse_bytes), when max_memory_given
+  bool max_memory_given = false;   ///< false: the limit is the machine's physical memory
   double checkpoint_every = 60.0;  ///< seconds between checkpoints during a render
   double rank_timeout = 600.0;     ///< under mpirun: seconds a rank may hold a tile (docs/mpi.md)
 };

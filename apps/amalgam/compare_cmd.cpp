@@ -8,6 +8,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 
 #include "amalgam/analysis/metrics.h"
 #include "amalgam/builtin/params.h"
@@ -54,6 +55,15 @@ int run_compare(const CompareOptions& o) {
     throw InputError(o.a + " is " + std::to_string(wa) + "x" + std::to_string(ha) + " but " + o.b +
                      " is " + std::to_string(wb) + "x" + std::to_string(hb) +
                      ": compare needs images of the same size");
+  // NaN compares false with everything: an all-NaN pair came out as SSIM 1 and max error 0.
+  for (const auto& [path, image] : {std::pair{&o.a, &a}, std::pair{&o.b, &b}}) {
+    std::size_t bad = 0;
+    for (const Vec3& p : *image)
+      bad += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+    if (bad > 0)
+      throw InputError(*path + ": " + std::to_string(bad) + " of " + std::to_string(image->size()) +
+                       " pixels are not finite (NaN or infinity): compare needs finite values");
+  }
   const ImageComparison c = compare_images(a, b, wa, ha);
 
   double vmax = 0;

@@ -79,30 +79,21 @@ int main(int argc, char** argv) {
   render->add_flag("--resume", extras.resume,
                    "continue an interrupted render from its checkpoint (same options)");
   render->add_flag("--quiet", extras.quiet, "no progress bar or summary on stderr");
-  render->add_option("--max-memory", extras.max_memory,
-                     "fail early if the render needs more bytes than this (suffixes K, M, G, T; "
-                     "default: physical memory)");
+  CLI::Option* max_memory = render->add_option(
+      "--max-memory", extras.max_memory,
+      "fail early if the render needs more bytes than this (suffixes K, M, G, T; default: "
+      "physical memory)");
   render
       ->add_option("--checkpoint-every", extras.checkpoint_every,
                    "seconds between checkpoints while rendering (default 60; 0: after every "
                    "pass of samples)")
-      ->check(CLI::Validator(
-          [](std::string& v) -> std::string {
-            try {
-              std::size_t end = 0;
-              const double x = std::stod(v, &end);
-              if (end == v.size() && x >= 0.0 && x <= 1e9) return "";
-            } catch (const std::exception&) {
-            }
-            return "expected seconds in [0, 1e9]";
-          },
-          "SECONDS"));
+      ->check(cli::seconds_in(0.0, 1e9, "[0, 1e9]"));
 
   render
       ->add_option("--rank-timeout", extras.rank_timeout,
                    "under mpirun: seconds a rank may hold a tile without answering before it is "
                    "taken as lost and its tile rendered by the others (default 600)")
-      ->check(CLI::Range(0.001, 1e9));
+      ->check(cli::seconds_in(0.001, 1e9, "[0.001, 1e9]"));
 
   cli::CommonOptions trace_opts;
   std::string origin, direction;
@@ -133,7 +124,8 @@ int main(int argc, char** argv) {
       ->required();
   experiment->add_option("--out", exp_out, "output directory")->required();
   experiment->add_flag("--quick", exp_quick, "small sizes (as the tests use)");
-  experiment->add_option("--threads", exp_threads, "worker threads (default: all cores)");
+  experiment->add_option("--threads", exp_threads, "worker threads (default: all cores)")
+      ->check(cli::non_negative_int());
 
   cli::CompareOptions cmp;
   CLI::App* compare = app.add_subcommand(
@@ -158,6 +150,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  extras.max_memory_given = max_memory->count() > 0;  // an empty value is given, and refused
   try {
     if (render->parsed()) return cli::run_render(render_opts, extras);
     if (trace->parsed()) return cli::run_trace(trace_opts, origin, direction);

@@ -264,8 +264,8 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
         throw InputError(ckpt + ": " + why + ": cannot resume from it");
     if (root) check_outputs(extra, ckpt, o, common.scene);  // the outputs are rank 0's
     const std::uint64_t asked =
-        extra.max_memory.empty() ? 0 : parse_bytes(extra.max_memory, "--max-memory");
-    if (!extra.max_memory.empty() && asked == 0)
+        extra.max_memory_given ? parse_bytes(extra.max_memory, "--max-memory") : 0;
+    if (extra.max_memory_given && asked == 0)
       throw InputError("--max-memory 0: expected a positive byte count");
     const std::uint64_t limit = asked ? asked : physical_memory();
     const std::uint64_t film = film_bytes(o);

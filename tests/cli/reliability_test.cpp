@@ -11,9 +11,12 @@
 #include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <zlib.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -21,6 +24,7 @@
 #include <fstream>
 #include <future>
 #include <iterator>
+#include <limits>
 #include <regex>
 #include <string>
 #include <vector>
@@ -298,6 +302,68 @@ TEST(Outputs, AnOutputOnAnInputIsRefusedAndTheInputKept) {
   EXPECT_EQ(amalgam("compare " + a + " " + b + " --error-image " + (d / "e.png")).status, 0);
 }
 
+/// A PNG chunk: length, type, data, CRC (big-endian), as the PNG specification lays it out.
+std::string png_chunk(const std::string& type, const std::string& data) {
+  std::string out;
+  const auto be32 = [&out](std::uint32_t v) {
+    for (int shift = 24; shift >= 0; shift -= 8) out += static_cast<char>((v >> shift) & 0xff);
+  };
+  be32(static_cast<std::uint32_t>(data.size()));
+  const std::string body = type + data;
+  out += body;
+  be32(static_cast<std::uint32_t>(
+      crc32(0, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size()))));
+  return out;
+}
+
+// compare refuses what would give meaningless figures or exhaust memory, with one line: images
+// with NaN or infinite pixels (an all-NaN pair came out as SSIM 1 and max error 0), and a PNG of
+// 110 bytes that claims 100000 x 100000 pixels (it printed "std::bad_alloc").
+TEST(BadInput, CompareRefusesNonFinitePixelsAndImagesLargerThanMemory) {
+  Dir d("compare-input");
+  const auto write_pfm = [&](const std::string& name, const std::vector<float>& values) {
+    std::ofstream f(d / name, std::ios::binary);
+    f << "PF\n2 2\n-1.0\n";  // negative scale: little-endian floats
+    f.write(reinterpret_cast<const char*>(values.data()),
+            static_cast<std::streamsize>(values.size() * sizeof(float)));
+  };
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  write_pfm("nan.pfm", std::vector<float>(12, nan));
+  std::vector<float> one_inf(12, 0.5f);
+  one_inf[4] = inf;
+  write_pfm("inf.pfm", one_inf);
+  write_pfm("fine.pfm", std::vector<float>(12, 0.5f));
+  struct Case {
+    std::string a, b, message;
+  };
+  const Case cases[] = {
+      {"nan.pfm", "nan.pfm", "nan.pfm: 4 of 4 pixels are not finite (NaN or infinity)"},
+      {"fine.pfm", "inf.pfm", "inf.pfm: 1 of 4 pixels are not finite (NaN or infinity)"},
+  };
+  for (const Case& c : cases) {
+    const CliResult r = amalgam("compare " + (d / c.a) + " " + (d / c.b));
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  EXPECT_EQ(amalgam("compare " + (d / "fine.pfm") + " " + (d / "fine.pfm")).status, 0);
+
+  std::string ihdr;
+  for (const std::uint32_t side : {100000u, 100000u})
+    for (int shift = 24; shift >= 0; shift -= 8) ihdr += static_cast<char>((side >> shift) & 0xff);
+  ihdr += std::string("\x08\x02\x00\x00\x00", 5);  // 8-bit RGB, no interlace
+  std::ofstream(d / "huge.png", std::ios::binary)
+      << std::string("\x89PNG\r\n\x1a\n", 8) << png_chunk("IHDR", ihdr)
+      << png_chunk("IDAT", std::string(16, '\0')) << png_chunk("IEND", "");
+  const CliResult r = amalgam("compare " + (d / "huge.png") + " " + (d / "huge.png"));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("huge.png: 100000 x 100000 pixels: decoding them needs"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("bad_alloc"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
 TEST(Numbers, OutOfRangeIsRefusedWithTheRangeNotClamped) {
   Dir d("numbers");
   const std::string out = " --out " + (d / "x.png");
@@ -319,6 +385,48 @@ TEST(Numbers, OutOfRangeIsRefusedWithTheRangeNotClamped) {
     EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
     EXPECT_LT(r.err.size(), 160u) << bad << ": a short line, not CLI11's range dump: " << r.err;
   }
+}
+
+// Values refused where they are checked elsewhere were accepted here: NaN seconds (CLI11's
+// range check lets NaN through), an empty byte count, negative experiment threads, and camera
+// coordinates beyond the range scene files are held to. Each is exit 2 with one line, no output.
+TEST(Numbers, NanEmptyAndOutOfRangeValuesAreRefusedAsElsewhere) {
+  Dir d("refused");
+  const std::string out = (d / "x.png");
+  struct Case {
+    std::string args, message;
+  };
+  const Case cases[] = {
+      {kSmall + " --rank-timeout nan", "expected seconds in [0.001, 1e9]"},
+      {kSmall + " --rank-timeout inf", "expected seconds in [0.001, 1e9]"},
+      {kSmall + " --rank-timeout 0", "expected seconds in [0.001, 1e9]"},
+      {kSmall + " --checkpoint-every nan", "expected seconds in [0, 1e9]"},
+      {kSmall + " --checkpoint-every ''", "expected seconds in [0, 1e9]"},
+      {kSmall + " --max-memory ''", "expected a byte count"},
+      {kSmall + " --eye 1e13,0,0", "within [-1e12, 1e12]"},
+      {kSmall + " --look-at 0,0,-2e12", "within [-1e12, 1e12]"},
+      {kSmall + " --up 1e20,0,0", "within [-1e12, 1e12]"},
+  };
+  for (const Case& c : cases) {
+    const CliResult r = amalgam(c.args + " --out " + out);
+    EXPECT_EQ(r.status, 2) << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
+  for (const char* threads : {"-1", "-2147483648", "1.5"}) {
+    const std::string dir = d / (std::string("exp") + threads);
+    const CliResult r =
+        amalgam(std::string("experiment expected --quick --threads ") + threads + " --out " + dir);
+    EXPECT_EQ(r.status, 2) << threads << ": " << r.err;
+    EXPECT_NE(r.err.find("expected an integer >= 0"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir)) << threads;
+  }
+  // The limits themselves are accepted.
+  EXPECT_EQ(
+      amalgam(kSmall + " --rank-timeout 0.001 --checkpoint-every 0 --eye 0,1e3,-1e3 --out " + out)
+          .status,
+      0);
 }
 
 TEST(BadInput, OneClearLineForEmptyBinaryLongOrLoopingInput) {

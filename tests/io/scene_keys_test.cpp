@@ -9,11 +9,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 
+#include "amalgam/io/json_reader.h"
 #include "amalgam/io/scene_json.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
+#include "amalgam/util/error.h"
 
 namespace amalgam {
 namespace {
@@ -184,6 +187,32 @@ TEST_F(SceneKeys, CameraUpIsTheTopOfTheImage) {
       EXPECT_NEAR(cy, 0, 1.5) << "and centred top to bottom";
     }
   }
+}
+
+// A key given twice in one object is refused, naming the object (nlohmann::json keeps the last
+// one silently: a scene file with two "camera" objects rendered the second); the same key in
+// different objects is not a duplicate.
+TEST(SceneJsonKeys, AKeyGivenTwiceInOneObjectIsRefused) {
+  struct Case {
+    std::string text, message;
+  };
+  const Case cases[] = {
+      {R"({"camera": {"fov": 40}, "camera": {"fov": 60}})",
+       "f.json: top level: key \"camera\" given twice"},
+      {R"({"a": 1, "b": {"c": [1, [2], {"d": 2, "e": {}, "d": 3}]}})",
+       "f.json: /b/c/2: key \"d\" given twice"},
+      {R"({"x/y": {"k": 1, "k": 1}})", "f.json: /x~1y: key \"k\" given twice"},
+  };
+  for (const Case& c : cases) {
+    try {
+      (void)parse_json(c.text, "f.json");
+      ADD_FAILURE() << "accepted: " << c.text;
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), c.message);
+    }
+  }
+  EXPECT_NO_THROW((void)parse_json(R"([{"a": 1}, {"a": 2}, {"b": {"a": 3}, "a": 4}])", "f.json"));
+  EXPECT_EQ(parse_json(R"({"a": {"x": 1}, "b": {"x": 2}})", "f.json")["b"]["x"], 2);
 }
 
 }  // namespace

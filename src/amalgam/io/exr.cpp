@@ -105,6 +105,7 @@ std::vector<Vec3> read_exr_rgba(const std::string& path, int& width, int& height
   const std::int64_t h = static_cast<std::int64_t>(dw.max.y) - dw.min.y + 1;
   if (w <= 0 || h <= 0 || w > 0x7fffffff || h > 0x7fffffff)
     throw Failure("invalid OpenEXR data window");
+  check_fits_in_memory(w, h, sizeof(Imf::Rgba) + sizeof(Vec3));
   std::vector<Imf::Rgba> rgba(static_cast<std::size_t>(w * h));
   // OpenEXR addresses the frame buffer by absolute pixel coordinates.
   const std::ptrdiff_t origin =
@@ -136,6 +137,7 @@ std::vector<Vec3> read_exr(const std::string& path, int& width, int& height) {
   const std::int64_t h = static_cast<std::int64_t>(dw.max.y) - dw.min.y + 1;
   if (w <= 0 || h <= 0 || w > 0x7fffffff || h > 0x7fffffff)
     throw Failure("invalid OpenEXR data window");
+  check_fits_in_memory(w, h, sizeof(Vec3));
   std::vector<Vec3> pixels(static_cast<std::size_t>(w * h));
   // OpenEXR addresses the frame buffer by absolute pixel coordinates.
   const std::ptrdiff_t origin =

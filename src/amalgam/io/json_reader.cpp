@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <functional>
+#include <set>
 #include <sstream>
+#include <vector>
 
 #include "amalgam/util/error.h"
 
@@ -50,11 +53,70 @@ std::string describe_overflow(const json::out_of_range& e, const std::string& te
          "is out of the range of a double";
 }
 
+/// Refuses a key given twice in one object (nlohmann keeps the last silently, so a scene file
+/// with two "camera" objects rendered the second): follows the parse as a stack of open
+/// objects and arrays, to name the object by its JSON pointer.
+class DuplicateKeyCheck {
+ public:
+  explicit DuplicateKeyCheck(const std::string& file) : file_(file) {}
+
+  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start:
+        open_.push_back({event == json::parse_event_t::object_start, {}, {}, 0});
+        break;
+      case json::parse_event_t::key: {
+        Open& o = open_.back();
+        o.key = parsed.get<std::string>();
+        if (!o.keys.insert(o.key).second)
+          throw InputError(file_ + ": " + (pointer().empty() ? "top level" : pointer()) +
+                           ": key \"" + one_line(o.key, 80) + "\" given twice");
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        open_.pop_back();
+        element_done();
+        break;
+      case json::parse_event_t::value:
+        element_done();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Open {
+    bool object;
+    std::set<std::string> keys;  ///< an object's keys so far
+    std::string key;             ///< an object's current key
+    std::size_t index;           ///< an array's current element
+  };
+
+  void element_done() {
+    if (!open_.empty() && !open_.back().object) ++open_.back().index;
+  }
+
+  /// The JSON pointer of the innermost open object or array.
+  std::string pointer() const {
+    std::string p;
+    for (std::size_t i = 0; i + 1 < open_.size(); ++i)
+      p += "/" +
+           (open_[i].object ? JsonReader::escape(open_[i].key) : std::to_string(open_[i].index));
+    return p;
+  }
+
+  const std::string& file_;
+  std::vector<Open> open_;
+};
+
 }  // namespace
 
 json parse_json(const std::string& text, const std::string& file) {
   try {
-    return json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    DuplicateKeyCheck check(file);
+    return json::parse(text, std::ref(check), /*allow_exceptions=*/true, /*ignore_comments=*/true);
   } catch (const json::parse_error& e) {
     throw InputError(file + ": " + describe_parse_error(e, text));
   } catch (const json::out_of_range& e) {

@@ -16,7 +16,8 @@
 namespace amalgam {
 
 /// Parses `text` (comments allowed). Throws InputError "<file>: line L, column C: invalid
-/// JSON: <what>" on a syntax error, and likewise for a number beyond the range of a double.
+/// JSON: <what>" on a syntax error, and likewise for a number beyond the range of a double;
+/// "<file>: <pointer of the object>: key "K" given twice" for a duplicate key.
 nlohmann::json parse_json(const std::string& text, const std::string& file);
 
 /// A value of a document with its JSON pointer ("/lights/0/intensity"; "" for the root).

@@ -2,6 +2,7 @@
 
 #include <png.h>
 
+#include <algorithm>
 #include <array>
 #include <csetjmp>
 #include <cstddef>
@@ -100,6 +101,9 @@ bool png_read_samples(std::FILE* fp, std::vector<std::uint8_t>& buf, PngLayout& 
   layout.bit_depth = png_get_bit_depth(png, info);
   layout.rowbytes = png_get_rowbytes(png, info);
   try {
+    // The samples and, per pixel, the three floats read_png makes of them.
+    check_fits_in_memory(layout.width, layout.height,
+                         layout.rowbytes / std::max<png_uint_32>(layout.width, 1) + 12);
     buf.assign(layout.rowbytes * layout.height, 0);
   } catch (...) {
     png_destroy_read_struct(&png, &info, nullptr);
