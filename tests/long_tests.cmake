@@ -15,5 +15,11 @@ set(AMALGAM_LONG_TESTS
   Volumetric.CorrelationFitGivesTheCoverage
   VolumeCells.CoverageAlongLinesMatchesTheHitProbability
   Experiments.ExpectedMatchesEq9AndRefutesPrintedEq12
+  BiasReference.CompositeFootprint2IsWithin3PercentOfFullDetailPerTile
+  StratifiedSampler.ConvergesFasterThanIndependentOnEdges
+  Volumetric.CloseUpIsFullDetail
+  Volumetric.SameBytesForAnyThreadCount
+  Volumetric.CellTestsAddUp
+  CliLimits.LoadPhasesShownOnATerminal
 )
 set_tests_properties(${AMALGAM_LONG_TESTS} PROPERTIES LABELS long)
