@@ -10,7 +10,8 @@ Usage: test_times.py TIMES CLONE [--install INSTALL_TIMES]
            (Testing/Temporary/CTestCostData.txt: each test's time)
   INSTALL  optional "stage<TAB>seconds" lines of two package installs, each on its own fresh
            Debian 12 root (scripts/time_install.sh): the demo's, then the tests' (every package)
-Machine and date are stamped on every figure; nothing here is typed by hand.
+Machine, date and the commit measured are stamped on every figure; nothing here is typed by
+hand.
 """
 import os
 import platform
@@ -90,8 +91,11 @@ def main():
     total = {name: s for name, s in times}
     cpu = subprocess.run(["sh", "-c", "grep -m1 'model name' /proc/cpuinfo | cut -d: -f2"],
                          capture_output=True, text=True).stdout.strip()
-    stamp = "%s, %d cores (%s), %s" % (platform.node() or "this machine", os.cpu_count(), cpu,
-                                         time.strftime("%Y-%m-%d"))
+    commit = subprocess.run(["git", "-C", clone, "rev-parse", "--short", "HEAD"],
+                            capture_output=True, text=True).stdout.strip() or "unknown"
+    stamp = "%s, %d cores (%s), %s, commit %s" % (platform.node() or "this machine",
+                                                   os.cpu_count(), cpu,
+                                                   time.strftime("%Y-%m-%d"), commit)
     # Two installs, each on its own fresh root: the demo's packages, then the tests' (all).
     demo_install = install[0][1] if install else None
     install_s = install[-1][1] if install else None
