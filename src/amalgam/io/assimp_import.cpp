@@ -19,10 +19,6 @@
 namespace amalgam {
 namespace {
 
-[[noreturn]] void fail(const std::string& path, const std::string& problem) {
-  throw InputError(path + ": " + problem);
-}
-
 /// Assimp's messages can span lines; the contract wants one line, kept whole (one_line).
 constexpr std::size_t kUncut = std::string::npos;
 
@@ -85,23 +81,23 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
       scene = importer.ApplyPostProcessing(kFlags & ~aiProcess_ValidateDataStructure);
     }
   } catch (const std::bad_alloc&) {
-    fail(path, "the importer ran out of memory (is the file corrupt?)");
+    fail_input(path, "the importer ran out of memory (is the file corrupt?)");
   } catch (const std::exception& e) {
-    fail(path, "cannot import: " + one_line(e.what(), kUncut));
+    fail_input(path, "cannot import: " + one_line(e.what(), kUncut));
   }
   // Assimp repairs some corrupt data with no more than a log message, and fails on other
   // corrupt data with a message about the consequence ("No meshes remaining"): name the cause.
   for (const auto* messages : {&logger->errors, &logger->warnings})
     for (const std::string& m : *messages)
       for (const char* pattern : kCorruptionMessages)
-        if (m.find(pattern) != std::string::npos) fail(path, "corrupt data: " + m);
+        if (m.find(pattern) != std::string::npos) fail_input(path, "corrupt data: " + m);
   if (scene == nullptr) {
     std::string why = one_line(importer.GetErrorString(), kUncut);
     if (why.empty() && !logger->errors.empty()) why = logger->errors.front();
-    fail(path, "cannot import: " + (why.empty() ? std::string("unknown error") : why));
+    fail_input(path, "cannot import: " + (why.empty() ? std::string("unknown error") : why));
   }
   if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
-    fail(path, "cannot import: the file holds no complete scene");
+    fail_input(path, "cannot import: the file holds no complete scene");
 
   out.warnings = std::move(logger->warnings);
   const std::vector<unsigned> channel = assimp_scene::read_materials(*scene, path, out);
@@ -113,8 +109,8 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
     if (m != nullptr && (m->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) faces += m->mNumFaces;
   }
   if (faces > config.max_triangles)
-    fail(path, std::to_string(faces) + " triangles, more than the limit of " +
-                   std::to_string(config.max_triangles));
+    fail_input(path, std::to_string(faces) + " triangles, more than the limit of " +
+                         std::to_string(config.max_triangles));
   out.triangles.reserve(faces);
   const bool textured = std::any_of(out.materials.begin(), out.materials.end(),
                                     [](const Surface& s) { return s.texture >= 0; });
@@ -130,7 +126,8 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
     for (unsigned v = 0; v < m->mNumVertices; ++v) {
       const aiVector3D& p = m->mVertices[v];
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-        fail(path, where + ": vertex " + std::to_string(v) + " is not finite (NaN or infinite)");
+        fail_input(path,
+                   where + ": vertex " + std::to_string(v) + " is not finite (NaN or infinite)");
     }
     std::uint32_t material = m->mMaterialIndex < out.materials.size() ? m->mMaterialIndex : 0;
     const aiVector3D* uv = nullptr;
@@ -157,8 +154,8 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
       for (int k = 0; k < 3; ++k) {
         const unsigned idx = face.mIndices[k];
         if (idx >= m->mNumVertices)
-          fail(path, where + ": face " + std::to_string(f) + " uses vertex " + std::to_string(idx) +
-                         " of " + std::to_string(m->mNumVertices));
+          fail_input(path, where + ": face " + std::to_string(f) + " uses vertex " +
+                               std::to_string(idx) + " of " + std::to_string(m->mNumVertices));
         const aiVector3D& q = m->mVertices[idx];
         p[k] = {q.x, q.y, q.z};
       }
@@ -188,9 +185,9 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
     }
   }
   if (out.triangles.empty())
-    fail(path, out.dropped_degenerate
-                   ? "all " + std::to_string(out.dropped_degenerate) + " triangles have zero area"
-                   : std::string("contains no triangles"));
+    fail_input(path, out.dropped_degenerate ? "all " + std::to_string(out.dropped_degenerate) +
+                                                  " triangles have zero area"
+                                            : std::string("contains no triangles"));
   return out;
 }
 

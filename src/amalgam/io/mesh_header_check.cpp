@@ -13,13 +13,6 @@
 #include "amalgam/util/error.h"
 
 namespace amalgam {
-namespace {
-
-[[noreturn]] void fail(const std::string& path, const std::string& problem) {
-  throw InputError(path + ": " + problem);
-}
-
-}  // namespace
 
 void check_mesh_header(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -44,7 +37,7 @@ void check_mesh_header(const std::string& path) {
       std::ostringstream m;
       m << "the header declares " << count << " " << what << " but the file has only "
         << static_cast<std::uint64_t>(size) << " bytes";
-      fail(path, m.str());
+      fail_input(path, m.str());
     }
   };
   if (ext == ".off") {
@@ -104,7 +97,8 @@ void check_mesh_header(const std::string& path) {
         std::string shown = line.substr(0, 60);
         for (char& c : shown)
           if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
-        fail(path, "malformed PLY header: line " + std::to_string(i + 1) + " is '" + shown + "'");
+        fail_input(path,
+                   "malformed PLY header: line " + std::to_string(i + 1) + " is '" + shown + "'");
       }
       if (kw == "element") {
         double count = 0;
@@ -112,9 +106,9 @@ void check_mesh_header(const std::string& path) {
         too_many(count, "elements");
       }
     }
-    if (!end) fail(path, "malformed PLY header: no 'end_header' line");
+    if (!end) fail_input(path, "malformed PLY header: no 'end_header' line");
     if (!elements.empty() && properties == 0)
-      fail(path, "malformed PLY header: the last element has no properties");
+      fail_input(path, "malformed PLY header: the last element has no properties");
   }
 }
 

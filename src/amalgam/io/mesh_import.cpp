@@ -23,10 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-[[noreturn]] void fail(const std::string& path, const std::string& problem) {
-  throw InputError(path + ": " + problem);
-}
-
 std::string errno_text(int err) {
   return std::error_code(err, std::generic_category()).message();
 }
@@ -136,15 +132,15 @@ class Helper {
   const std::string why = WIFSIGNALED(status)
                               ? "signal " + std::to_string(WTERMSIG(status))
                               : "exit status " + std::to_string(WEXITSTATUS(status));
-  fail(path, "the importer crashed on this file (" + why + "); is it corrupt?");
+  fail_input(path, "the importer crashed on this file (" + why + "); is it corrupt?");
 }
 
 }  // namespace
 
 ImportedMesh import_mesh(const std::string& path, const ImportConfig& config) {
   std::error_code ec;
-  if (!fs::exists(path, ec)) fail(path, "no such file");
-  if (!fs::is_regular_file(path, ec)) fail(path, "not a regular file");
+  if (!fs::exists(path, ec)) fail_input(path, "no such file");
+  if (!fs::is_regular_file(path, ec)) fail_input(path, "not a regular file");
   check_mesh_header(path);
 
   const std::string helper_path = find_helper(config);

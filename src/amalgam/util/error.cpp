@@ -4,6 +4,10 @@
 
 namespace amalgam {
 
+void fail_input(const std::string& file, const std::string& problem) {
+  throw InputError(file + ": " + problem);
+}
+
 std::string one_line(const std::string& text, std::size_t max) {
   std::string s;
   for (char c : text) s += (c == '\n' || c == '\r' || c == '\t') ? ' ' : c;

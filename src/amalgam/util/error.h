@@ -19,6 +19,9 @@ struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Throws InputError("<file>: <problem>").
+[[noreturn]] void fail_input(const std::string& file, const std::string& problem);
+
 /// A failure of the work itself, not of its input (I/O, resources, a helper process).
 struct RuntimeError : std::runtime_error {
   using std::runtime_error::runtime_error;

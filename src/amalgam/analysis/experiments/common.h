@@ -79,4 +79,9 @@ inline double line_deterministic_shadow(int n, int l1) {
   return total;
 }
 
+/// Rec. 709 luma of a pixel, in double precision (the noise experiments' variance is taken on it).
+inline double luma(const Vec3& v) {
+  return 0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z;
+}
+
 }  // namespace amalgam::experiments::detail

@@ -11,10 +11,6 @@ using namespace detail;
 
 namespace {
 
-double luma(const Vec3& v) {
-  return 0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z;
-}
-
 struct NoisePoint {
   double variance = 0;  ///< mean over pixels of the variance across seeds
   double tests_per_sample = 0;

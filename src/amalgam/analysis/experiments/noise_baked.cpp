@@ -20,10 +20,6 @@ using namespace detail;
 
 namespace {
 
-double luma(const Vec3& v) {
-  return 0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z;
-}
-
 /// Per-sample variance (mean over pixels of the variance of the pixel across seeds, times
 /// spp) and intersection tests per sample.
 std::pair<double, double> per_sample(const LoadedScene& s, RenderOptions o, int seeds) {
