@@ -33,6 +33,31 @@
 namespace py = pybind11;
 using namespace amalgam;
 
+/// An integer argument that refuses True and False: Python's bool is an int, so width=True
+/// would otherwise render one pixel wide. A bool is then a TypeError, as a float is.
+template <class T>
+struct Strict {
+  T value{};
+  operator T() const { return value; }  // NOLINT: used where the plain integer is
+};
+
+namespace pybind11::detail {
+template <class T>
+struct type_caster<Strict<T>> {
+  PYBIND11_TYPE_CASTER(Strict<T>, const_name("int"));
+  bool load(handle src, bool convert) {
+    if (PyBool_Check(src.ptr())) return false;
+    make_caster<T> plain;
+    if (!plain.load(src, convert)) return false;
+    value.value = cast_op<T>(plain);
+    return true;
+  }
+  static handle cast(Strict<T> v, return_value_policy policy, handle parent) {
+    return make_caster<T>::cast(v.value, policy, parent);
+  }
+};
+}  // namespace pybind11::detail
+
 namespace {
 
 static_assert(sizeof(Vec3) == 3 * sizeof(float), "images are viewed as float32 H x W x 3");
@@ -213,14 +238,13 @@ struct Scene {
     return embree;
   }
 
-  std::shared_ptr<RenderResult> render(int width, int height, int spp, const std::string& renderer,
-                                       const std::string& opacity, std::optional<int> level,
-                                       std::optional<float> footprint, const std::string& order,
-                                       std::uint64_t seed, int threads, const std::string& sampler,
-                                       const py::object& camera, const py::object& eye,
-                                       const py::object& look_at, const py::object& up,
-                                       const py::object& fov, const py::object& light_samples,
-                                       const std::string& tracer_name) {
+  std::shared_ptr<RenderResult> render(
+      Strict<int> width, Strict<int> height, Strict<int> spp, const std::string& renderer,
+      const std::string& opacity, std::optional<Strict<int>> level, std::optional<float> footprint,
+      const std::string& order, Strict<std::uint64_t> seed, Strict<int> threads,
+      const std::string& sampler, const py::object& camera, const py::object& eye,
+      const py::object& look_at, const py::object& up, const py::object& fov,
+      const py::object& light_samples, const std::string& tracer_name) {
     const Options opt = make_options(width, height, spp, renderer, opacity, level, footprint, order,
                                      seed, threads, sampler, tracer_name);
     check_options(*scene, opt.o, OptionSpelling::kKeywords);
@@ -274,9 +298,10 @@ struct Scene {
   }
 
   py::dict trace(std::optional<std::vector<float>> origin,
-                 std::optional<std::vector<float>> direction, int width, int height,
-                 const std::string& renderer, const std::string& opacity, std::optional<int> level,
-                 std::optional<float> footprint, const std::string& order, std::uint64_t seed,
+                 std::optional<std::vector<float>> direction, Strict<int> width, Strict<int> height,
+                 const std::string& renderer, const std::string& opacity,
+                 std::optional<Strict<int>> level, std::optional<float> footprint,
+                 const std::string& order, Strict<std::uint64_t> seed,
                  const std::string& tracer_name) {
     const Options opt = make_options(width, height, 1, renderer, opacity, level, footprint, order,
                                      seed, 1, "independent", tracer_name);
@@ -369,7 +394,7 @@ py::dict compare(const py::object& a, const py::object& b) {
   return d;
 }
 
-py::object experiment(const std::string& name, bool quick, int threads, bool frame) {
+py::object experiment(const std::string& name, bool quick, Strict<int> threads, bool frame) {
   const auto& names = experiments::names();
   if (std::find(names.begin(), names.end(), name) == names.end()) {
     std::string all;

@@ -44,6 +44,21 @@ def test_level_beyond_lmax_is_value_error(cli, demo, tmp_path):
     assert str(e.value) == message.replace("--level 99", "level=99")
 
 
+def test_booleans_are_not_integers(demo):
+    # Python's bool is an int: width=True used to render one pixel wide. Refused as a float is.
+    for keyword in ("width", "height", "spp", "seed", "threads", "level"):
+        with pytest.raises(TypeError):
+            demo.render(**{"width": 8, "height": 8, "spp": 1, keyword: True})
+        with pytest.raises(TypeError):
+            demo.render(**{"width": 8, "height": 8, "spp": 1, keyword: 1.0})
+    for keyword in ("width", "height", "seed", "level"):
+        with pytest.raises(TypeError):
+            demo.trace(**{keyword: False})
+    with pytest.raises(TypeError):
+        amalgam.experiment("noise", threads=True)
+    assert demo.render(width=8, height=8, spp=1, seed=1, threads=1, level=1).image.shape == (8, 8, 3)
+
+
 def test_bad_options_are_value_errors(demo, tmp_path):
     with pytest.raises(ValueError, match="give one"):
         demo.render(width=8, height=8, level=1, footprint=2.0)
