@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -102,6 +103,38 @@ std::string fingerprint(const CommonOptions& c, const LoadedScene& scene) {
 /// path must be writable, no two outputs may be the same file and none may be the scene file
 /// (compared by file identity: device and inode, or the resolved path of a new file). Throws
 /// InputError.
+struct Output {
+  const char* option;
+  const std::string& path;
+};
+
+/// The files a render writes, by option (an empty path: not written).
+std::array<Output, 5> outputs(const RenderExtras& e, const std::string& ckpt) {
+  return {{{"--out", e.out},
+           {"--cost-image", e.cost_image},
+           {"--level-image", e.level_image},
+           {"--stats", e.stats},
+           {"--checkpoint", ckpt}}};
+}
+
+/// Once the scene is loaded, before anything is written: no output on a file it read (the
+/// meshes a scene file names and the textures they name; the scene file itself was checked
+/// before loading). Throws InputError.
+void check_outputs_spare_inputs(const RenderExtras& e, const std::string& ckpt,
+                                const LoadedScene& scene) {
+  std::vector<std::pair<std::string, const std::string*>> inputs;  // by identity
+  for (const std::string& in : scene.inputs) inputs.emplace_back(file_identity(in), &in);
+  for (const Output& o : outputs(e, ckpt)) {
+    if (o.path.empty() || resolve_output(o.path).kind != OutputTarget::Kind::kFile) continue;
+    const std::string key = file_identity(o.path);
+    for (const auto& [identity, path] : inputs)
+      if (identity == key)
+        throw InputError(std::string(o.option) + " " + o.path + ": " + *path +
+                         ", which the scene " + scene.name +
+                         " reads (an output never replaces an input)");
+  }
+}
+
 void check_outputs(const RenderExtras& e, const std::string& ckpt, const RenderOptions& ro,
                    const std::string& scene) {
   if (!e.cost_image.empty() && ro.tracer == TracerKind::kEmbree)
@@ -115,20 +148,11 @@ void check_outputs(const RenderExtras& e, const std::string& ckpt, const RenderO
   if (!e.level_image.empty() && !is_image_path(e.level_image))
     throw InputError("--level-image " + e.level_image +
                      ": unsupported image format (expected .png, .exr or .pfm)");
-  struct Output {
-    const char* option;
-    const std::string& path;
-  };
-  const Output outputs[] = {{"--out", e.out},
-                            {"--cost-image", e.cost_image},
-                            {"--level-image", e.level_image},
-                            {"--stats", e.stats},
-                            {"--checkpoint", ckpt}};
   std::error_code ec;
   const bool scene_file = scene.rfind("builtin:", 0) != 0 && std::filesystem::exists(scene, ec);
   const std::string input = scene_file ? file_identity(scene) : std::string();
   std::vector<std::pair<std::string, const char*>> files;  // regular files, by identity
-  for (const Output& o : outputs) {
+  for (const Output& o : outputs(e, ckpt)) {
     if (o.path.empty()) continue;
     check_writable(o.path);
     const OutputTarget t = resolve_output(o.path);
@@ -279,12 +303,15 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
     budget.max_bytes = limit - film;
     budget.limit_name = "--max-memory " + format_bytes(static_cast<double>(limit)) + " less " +
                         format_bytes(static_cast<double>(film)) + " for the film";
+    budget.import_max_bytes = limit;
+    budget.import_limit_name = "--max-memory " + format_bytes(static_cast<double>(limit));
     budget.objects = o.renderer() == RendererKind::kVolumetric;
     budget.on_phase = [&](const std::string& what) {
       set_activity(what);
       status.phase(what);
     };
     loaded.emplace(load_scene(common.scene, common.params(), budget));
+    if (root) check_outputs_spare_inputs(extra, ckpt, *loaded);
     common.prepare(*loaded);  // the view options, before the fingerprint takes the camera
     if (o.tracer == TracerKind::kEmbree) {
       set_activity("building Embree's BVH of " + common.scene);

@@ -4,6 +4,7 @@
 /// does depends on the mesh file's stem:
 ///   too-many        replies with 2 triangles whatever --max-triangles says, then waits forever
 ///   other-protocol  replies in another protocol, then waits forever
+///   never-answers   waits forever without a word (as an importer caught in a loop would)
 ///   anything else   aborts (SIGABRT), as Assimp 5.2 does on some corrupt files
 
 #include <unistd.h>
@@ -28,7 +29,7 @@ int main(int argc, char** argv) {
     const std::string hello = "amalgam-import protocol 0";
     const std::uint64_t n = hello.size();
     if (::write(1, &n, sizeof n) != sizeof n || ::write(1, hello.data(), n) != ssize_t(n)) return 1;
-  } else {
+  } else if (stem != "never-answers") {
     std::abort();
   }
   for (;;) ::pause();

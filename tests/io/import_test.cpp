@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "../sanitized.h"
 #include "amalgam/io/mesh_import.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
@@ -181,6 +182,118 @@ TEST(MeshImport, AMisbehavingOrMissingHelperIsStoppedAndReported) {
   ::unsetenv("AMALGAM_IMPORT_HELPER");
   EXPECT_NE(c.find("the importer crashed on this file (signal 6)"), std::string::npos) << c;
   EXPECT_EQ(import_mesh((d / "crash.obj").string()).triangles.size(), 1u);
+}
+
+// A helper that never answers (an importer caught in a loop, or blocked) is killed at the
+// deadline (ImportConfig::timeout_seconds, else AMALGAM_IMPORT_TIMEOUT): one InputError, not a
+// wait forever (it used to block amalgam for good).
+TEST(MeshImport, AHelperThatNeverAnswersIsStoppedAtTheDeadline) {
+  const fs::path d = temp_dir("deadline");
+  const std::string mesh = (d / "never-answers.obj").string();
+  write_file(mesh, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  ImportConfig fake;
+  fake.helper = AMALGAM_FAKE_IMPORTER;
+  fake.timeout_seconds = 0.5;
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(input_error([&] { (void)import_mesh(mesh, fake); }),
+            mesh +
+                ": the importer did not finish within 0.5 s (is the file corrupt? "
+                "AMALGAM_IMPORT_TIMEOUT sets the limit)");
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));
+  fake.timeout_seconds = 0;
+  ::setenv("AMALGAM_IMPORT_TIMEOUT", "0.25", 1);
+  const std::string by_env = input_error([&] { (void)import_mesh(mesh, fake); });
+  ::setenv("AMALGAM_IMPORT_TIMEOUT", "soon", 1);
+  const std::string bad_env = input_error([&] { (void)import_mesh(mesh, fake); });
+  ::unsetenv("AMALGAM_IMPORT_TIMEOUT");
+  EXPECT_NE(by_env.find("did not finish within 0.25 s"), std::string::npos) << by_env;
+  EXPECT_EQ(bad_env, "AMALGAM_IMPORT_TIMEOUT=soon: expected seconds, a number in (0, 1e7]");
+  // The real helper, well within its deadline.
+  EXPECT_EQ(import_mesh(mesh).triangles.size(), 1u);
+}
+
+// The helper allocates no more than the memory limit it is given (RLIMIT_DATA): an import that
+// needs more is one InputError naming the limit. Not under AddressSanitizer, whose shadow
+// memory counts against RLIMIT_DATA (the helper does not set the limit there).
+TEST(MeshImport, TheHelperStaysUnderTheMemoryLimit) {
+  REQUIRE_MODELS();
+  if (kSanitized) GTEST_SKIP() << "RLIMIT_DATA counts AddressSanitizer's shadow memory";
+  const std::string path = (kModels / "PLY/Wuson.ply").string();
+  ImportConfig small;
+  small.max_bytes = 1 << 20;
+  small.limit_name = "--max-memory 1 MiB";
+  EXPECT_EQ(input_error([&] { (void)import_mesh(path, small); }),
+            path +
+                ": the importer ran out of memory under --max-memory 1 MiB (is the file "
+                "corrupt?)");
+  ImportConfig ample;
+  ample.max_bytes = std::uint64_t{1} << 30;
+  EXPECT_EQ(import_mesh(path, ample).triangles.size(), 3732u);
+}
+
+// Sizes and indices that Assimp 5.2 trusts or repairs without a word are refused before it
+// reads, or from its own log: a 200-byte GLB whose chunk claims 2 GB (it allocated 2.1 GB and
+// took 17 s to fail), a glTF byteOffset of -100, an OFF face index beyond the vertices, a PLY
+// face list longer than its line (each of the last three rendered one triangle, exit 0).
+TEST(BadInput, DeclaredSizesAndIndicesTheFileCannotHoldAreRefused) {
+  const fs::path d = temp_dir("declared");
+  auto le32 = [](std::uint32_t v) {
+    std::string s(4, '\0');
+    for (int i = 0; i < 4; ++i) s[i] = static_cast<char>(v >> (8 * i));
+    return s;
+  };
+  std::string glb = "glTF" + le32(2) + le32(200) + le32(0x7ffffff0) + "JSON{}";
+  glb.resize(200, ' ');
+  write_file(d / "hostile.glb", glb);
+  write_file(d / "short.glb", "glTF" + le32(2) + le32(4000) + le32(2) + "JSON{}");
+  const std::string triangle =
+      R"("scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+      R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+      R"("buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,)"
+      R"(AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],)";
+  write_file(d / "view.gltf",
+             R"({"asset":{"version":"2.0"},)" + triangle +
+                 R"("bufferViews":[{"buffer":0,"byteOffset":-100,"byteLength":36}],)"
+                 R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",)"
+                 R"("min":[0,0,0],"max":[1,1,0]}]})");
+  write_file(d / "accessor.gltf",
+             R"({"asset":{"version":"2.0"},)" + triangle +
+                 R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+                 R"("accessors":[{"bufferView":0,"byteOffset":1.5,"componentType":5126,)"
+                 R"("count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}]})");
+  write_file(d / "index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n");
+  write_file(d / "list.ply",
+             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+             "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+             "end_header\n0 0 0\n1 0 0\n0 1 0\n200 0 1 2\n");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"hostile.glb",
+       "binary glTF: chunk 0 (at byte 12) ends at byte 2147483652, beyond the end of the file "
+       "(200 bytes)"},
+      {"short.glb",
+       "binary glTF: the header's total length ends at byte 4000, beyond the end of the file "
+       "(22 bytes)"},
+      {"view.gltf", "bufferViews/0/byteOffset is -100, not a non-negative integer"},
+      {"accessor.gltf", "accessors/0/byteOffset is 1.5, not a non-negative integer"},
+      {"index.off", "corrupt data: OFF: Vertex index is out of range"},
+      {"list.ply",
+       "corrupt data: Unable to parse property instance. Skipping this element instance"},
+  };
+  for (const auto& [name, problem] : cases) {
+    const std::string path = (d / name).string();
+    const auto t0 = std::chrono::steady_clock::now();
+    EXPECT_EQ(input_error([&] { (void)import_mesh(path); }), path + ": " + problem);
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5)) << name;
+  }
+  // The same files with sizes and indices in range import.
+  write_file(d / "good.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  write_file(d / "good.gltf",
+             R"({"asset":{"version":"2.0"},)" + triangle +
+                 R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":36}],)"
+                 R"("accessors":[{"bufferView":0,"byteOffset":0,"componentType":5126,)"
+                 R"("count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}]})");
+  for (const char* name : {"good.off", "good.gltf"})
+    EXPECT_EQ(import_mesh((d / name).string()).triangles.size(), 1u) << name;
 }
 
 /// The state letter of /proc/PID/stat ('S' sleeping, 'Z' zombie, ...), '?' once it is gone,

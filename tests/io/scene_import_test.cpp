@@ -6,9 +6,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numbers>
 #include <string>
 
@@ -24,7 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 const fs::path kGltf = "/usr/share/assimp/models/glTF2";
 
-#define REQUIRE_GLTF_MODELS()               \
+#define REQUIRE_GLTF_MODELS()          \
   ASSERT_TRUE(fs::is_directory(kGltf)) \
       << kGltf << " is missing: install Debian's assimp-testmodels package (scripts/deps.sh)"
 
@@ -352,6 +354,58 @@ TEST(Texture, ObjCorruptJpegAndMissingCoordinatesWarnAndRender) {
   EXPECT_EQ(b.materials[b.triangles[0].material].texture, -1);
   ASSERT_EQ(b.dropped.size(), 2u);  // bad.jpg again, and the coordinates
   EXPECT_NE(b.dropped[1].find("no texture coordinates"), std::string::npos) << b.dropped[1];
+}
+
+// Textures are hostile input too: an image that claims 65535 x 65535 texels (refused from
+// its header, before any texel is allocated), a PNG and a JPEG cut in half, a TGA (not
+// decoded): each is one warning naming it, its material renders with its colour, the rest
+// of the mesh imports, quickly.
+TEST(Texture, HostileAndTruncatedImagesAreOneWarningEachAndTheColour) {
+  REQUIRE_GLTF_MODELS();
+  const fs::path d = scratch_dir() / "hostile";
+  fs::create_directories(d);
+  const char huge_png[] =
+      "\x89\x50\x4e\x47\x0d\x0a\x1a\x0a\x00\x00\x00\x0d\x49\x48\x44\x52\x00\x00\xff\xff\x00\x00"
+      "\xff\xff\x08\x02\x00\x00\x00\x39\x67\x4e\x07\x00\x00\x00\x0b\x49\x44\x41\x54\x78\x9c\x63"
+      "\x60\x40\x05\x00\x00\x10\x00\x01\x39\xbd\x8f\x65\x00\x00\x00\x00\x49\x45\x4e\x44\xae\x42"
+      "\x60\x82";
+  write(d / "huge.png", std::string(huge_png, sizeof huge_png - 1));
+  auto half_of = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(in), {}};
+    return bytes.substr(0, bytes.size() / 2);
+  };
+  write(d / "half.png", half_of(kGltf / "BoxTextured-glTF/CesiumLogoFlat.png"));
+  write(d / "half.jpg", half_of("/usr/share/assimp/models/OBJ/SpiderTex.jpg"));
+  // An uncompressed 2 x 2 true-colour TGA: a valid image in a format not decoded.
+  write(d / "image.tga",
+        std::string("\0\0\2\0\0\0\0\0\0\0\0\0\2\0\2\0\x18\0", 18) + std::string(12, '\x7f'));
+  std::string mtl, obj = "mtllib m.mtl\nvt 0 0\nvt 1 0\nvt 0 1\n";
+  const char* images[] = {"huge.png", "half.png", "half.jpg", "image.tga"};
+  for (int i = 0; i < 4; ++i) {
+    mtl += "newmtl m" + std::to_string(i) + "\nKd 0.5 0.25 " + std::to_string(0.2 * (i + 1)) +
+           "\nmap_Kd " + images[i] + "\n";
+    obj += "v " + std::to_string(2 * i) + " 0 0\nv " + std::to_string(2 * i + 1) + " 0 0\nv " +
+           std::to_string(2 * i) + " 1 0\nusemtl m" + std::to_string(i) + "\nf " +
+           std::to_string(3 * i + 1) + "/1 " + std::to_string(3 * i + 2) + "/2 " +
+           std::to_string(3 * i + 3) + "/3\n";
+  }
+  write(d / "m.mtl", mtl);
+  write(d / "a.obj", obj);
+  const auto t0 = std::chrono::steady_clock::now();
+  const ImportedMesh m = import_mesh((d / "a.obj").string());
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(10));
+  ASSERT_EQ(m.triangles.size(), 4u);
+  for (const Primitive& t : m.triangles) {
+    const Surface& s = m.materials[t.material];
+    EXPECT_EQ(s.texture, -1);
+    EXPECT_EQ(s.colour.x, 0.5f);
+  }
+  std::string all;
+  for (const std::string& line : m.dropped) all += line + "\n";
+  for (const char* image : images)
+    EXPECT_NE(all.find(std::string("'") + image + "'"), std::string::npos) << image << "\n" << all;
+  EXPECT_NE(all.find("65535x65535 texels"), std::string::npos) << all;
 }
 
 TEST(GltfCamera, TheFirstPerspectiveCameraAsTheFileGivesIt) {

@@ -40,11 +40,15 @@ class CaptureLogger : public Assimp::Logger {
 /// Log messages by which Assimp reports that it dropped or replaced corrupt data. Other
 /// messages (e.g. about invalid normals, which amalgam does not use) are harmless.
 constexpr const char* kCorruptionMessages[] = {
-    "out-of-range indices",         // glTF 2: faces referencing missing vertices
-    "Ignoring empty face",          // OBJ: an 'f' statement without vertices
-    "was not compatible with the",  // glTF 2: vertex count does not fit the mode
-    "Invalid face index",           // OBJ
-    "fails on mesh positions",      // FindInvalidData: NaN or infinite vertex positions
+    "out-of-range indices",               // glTF 2: faces referencing missing vertices
+    "Ignoring empty face",                // OBJ: an 'f' statement without vertices
+    "was not compatible with the",        // glTF 2: vertex count does not fit the mode
+    "Invalid face index",                 // OBJ
+    "fails on mesh positions",            // FindInvalidData: NaN or infinite vertex positions
+    "OFF: Vertex index is out of range",  // replaced by the last vertex
+    "OFF: Faces with zero indices",       // the face dropped
+    "OFF: The number of faces in the header is incorrect",
+    "Unable to parse property instance",  // PLY: a line shorter than its properties say
 };
 
 bool is_gltf(const std::string& path) {
@@ -54,6 +58,11 @@ bool is_gltf(const std::string& path) {
 }
 
 }  // namespace
+
+std::string out_of_memory_message(const std::string& path, const ImportConfig& config) {
+  return path + ": the importer ran out of memory under " + config.limit_name +
+         " (is the file corrupt?)";
+}
 
 ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& config) {
   auto* logger = new CaptureLogger;  // owned by Assimp until set(nullptr) below
@@ -81,7 +90,7 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
       scene = importer.ApplyPostProcessing(kFlags & ~aiProcess_ValidateDataStructure);
     }
   } catch (const std::bad_alloc&) {
-    fail_input(path, "the importer ran out of memory (is the file corrupt?)");
+    throw InputError(out_of_memory_message(path, config));
   } catch (const std::exception& e) {
     fail_input(path, "cannot import: " + one_line(e.what(), kUncut));
   }
@@ -93,6 +102,9 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
         if (m.find(pattern) != std::string::npos) fail_input(path, "corrupt data: " + m);
   if (scene == nullptr) {
     std::string why = one_line(importer.GetErrorString(), kUncut);
+    // Assimp catches an exception from a reader itself and keeps only its what().
+    if (why.find("bad_alloc") != std::string::npos)
+      throw InputError(out_of_memory_message(path, config));
     if (why.empty() && !logger->errors.empty()) why = logger->errors.front();
     fail_input(path, "cannot import: " + (why.empty() ? std::string("unknown error") : why));
   }

@@ -15,4 +15,7 @@ namespace amalgam {
 /// captured. Not thread-safe (Assimp's logger is process-wide).
 ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& config);
 
+/// "<path>: the importer ran out of memory under <config.limit_name> (is the file corrupt?)".
+std::string out_of_memory_message(const std::string& path, const ImportConfig& config);
+
 }  // namespace amalgam

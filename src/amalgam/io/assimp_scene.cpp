@@ -111,8 +111,10 @@ bool read_bytes(const fs::path& p, std::uintmax_t limit, std::vector<std::uint8_
 }
 
 /// Loads the texture `ref` of the mesh at `path` (embedded, or a file beside the mesh).
+/// A texture file found is recorded in `files`, read or not.
 bool load_texture(const aiScene& scene, const std::string& path, const std::string& ref,
-                  std::uint64_t budget, Texture& t, std::string& why) {
+                  std::uint64_t budget, Texture& t, std::string& why,
+                  std::vector<std::string>& files) {
   const std::uint64_t max_texels = budget / 3;
   const auto side = import_protocol::kMaxTextureSide;
   if (const aiTexture* e = scene.GetEmbeddedTexture(ref.c_str())) {
@@ -146,7 +148,10 @@ bool load_texture(const aiScene& scene, const std::string& path, const std::stri
   for (const fs::path& p : {fs::path(ref), fs::path(slashed), fs::path(slashed).filename()}) {
     file = p.is_absolute() ? p : dir / p;
     std::error_code ec;
-    if (fs::is_regular_file(file, ec)) break;
+    if (fs::is_regular_file(file, ec)) {
+      files.push_back(file.string());
+      break;
+    }
   }
   std::vector<std::uint8_t> bytes;
   if (!read_bytes(file, std::uintmax_t{1} << 30, bytes, why)) return false;
@@ -376,7 +381,7 @@ std::vector<unsigned> read_materials(const aiScene& scene, const std::string& pa
           Texture t;
           std::string why;
           std::int32_t index = -1;
-          if (load_texture(scene, path, ref.C_Str(), budget, t, why)) {
+          if (load_texture(scene, path, ref.C_Str(), budget, t, why, out.texture_files)) {
             budget -= t.texels.size();
             t.wrap_u = wrap_u, t.wrap_v = wrap_v;
             index = static_cast<std::int32_t>(out.textures.size());

@@ -27,9 +27,11 @@ namespace {
 constexpr char kMagicPrefix[] = "AMALGAM-CHECKPOINT-";
 constexpr char kMagic[] = "AMALGAM-CHECKPOINT-5";
 
-/// Checksum of a checkpoint's bytes (everything before the checksum itself): 64-bit words
-/// through hash_combine, so any flipped bit changes it (with probability 1 - 2^-64).
-std::uint64_t checksum(std::string_view bytes) {
+}  // namespace
+
+/// 64-bit words through hash_combine, so any flipped bit changes it (with probability
+/// 1 - 2^-64).
+std::uint64_t checkpoint_checksum(std::string_view bytes) {
   std::uint64_t h = 0xc4ec4ec4ull;
   std::size_t i = 0;
   for (; i + 8 <= bytes.size(); i += 8) {
@@ -41,6 +43,8 @@ std::uint64_t checksum(std::string_view bytes) {
   for (; i < bytes.size(); ++i) tail = tail * 257 + static_cast<unsigned char>(bytes[i]);
   return hash_combine(h, tail);
 }
+
+namespace {
 
 /// Appends raw bytes to a string reserved to the checkpoint's exact size, so the film is held
 /// once more while writing, not twice or three times as a growing stream would (MemoryModel).
@@ -82,7 +86,7 @@ void write_checkpoint(const std::string& path, const std::string& fingerprint,
   put(bytes, st.counters);
   put(bytes, distinct);
   st.per_primary.for_each([&](std::uint64_t v, std::uint64_t c) { put(bytes, v), put(bytes, c); });
-  const std::uint64_t sum = checksum(bytes);
+  const std::uint64_t sum = checkpoint_checksum(bytes);
   put(bytes, sum);
   write_file_atomic(path, bytes);
 }
@@ -173,7 +177,7 @@ FilmState read_checkpoint(const std::string& path, const std::string& fingerprin
   std::uint64_t stored = 0;
   std::memcpy(&stored, bytes.data() + bytes.size() - sizeof stored, sizeof stored);
   bytes.resize(bytes.size() - sizeof stored);
-  if (checksum(bytes) != stored)
+  if (checkpoint_checksum(bytes) != stored)
     throw InputError(path + ": checkpoint is damaged (checksum mismatch): delete it to start over");
   std::istringstream in(bytes, std::ios::binary);
   in.seekg(sizeof kMagic);

@@ -3,7 +3,9 @@
 /// that determines the image (scene, parameters, options other than spp and threads), so a
 /// render is only ever resumed with the settings it was started with.
 
+#include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "amalgam/render/render.h"
 
@@ -16,5 +18,10 @@ void write_checkpoint(const std::string& path, const std::string& fingerprint,
 /// Reads a checkpoint; throws InputError naming the file when it is unreadable, corrupt, or
 /// was written for a different fingerprint.
 FilmState read_checkpoint(const std::string& path, const std::string& fingerprint);
+
+/// The checksum a checkpoint ends with (8 bytes), of all the bytes before it: for the tests and
+/// the fuzzer (fuzz/checkpoint_fuzz.cpp), which make checkpoints that pass it to reach the
+/// checks behind it.
+std::uint64_t checkpoint_checksum(std::string_view bytes);
 
 }  // namespace amalgam

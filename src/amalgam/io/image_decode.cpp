@@ -3,6 +3,7 @@
 // clang-format off
 #include <cstdio>  // jpeglib.h needs FILE and size_t declared first
 #include <jpeglib.h>
+#include <jerror.h>  // after jpeglib.h: the warning codes (JWRN_*)
 // clang-format on
 #include <png.h>
 
@@ -71,7 +72,14 @@ extern "C" void jpeg_fail(j_common_ptr cinfo) {
   std::longjmp(e->jump, 1);
 }
 
-extern "C" void jpeg_quiet(j_common_ptr) {}  // warnings about recoverable data: not printed
+extern "C" void jpeg_quiet(j_common_ptr) {}  // nothing printed
+
+/// Warnings: a file cut short (libjpeg fills the missing rows with grey) fails as corrupt data;
+/// other recoverable oddities (extraneous bytes before a marker, common in real files) pass.
+extern "C" void jpeg_warning(j_common_ptr cinfo, int level) {
+  const int code = cinfo->err->msg_code;
+  if (level < 0 && (code == JWRN_JPEG_EOF || code == JWRN_HIT_MARKER)) jpeg_fail(cinfo);
+}
 
 /// Decodes into `*pixels` (malloc'ed, RGB rows; the caller frees it). Only trivially
 /// destructible locals, as longjmp skips destructors.
@@ -83,6 +91,7 @@ bool decode_jpeg_raw(const std::uint8_t* data, std::size_t size, std::uint64_t m
   cinfo.err = jpeg_std_error(&err.mgr);
   err.mgr.error_exit = jpeg_fail;
   err.mgr.output_message = jpeg_quiet;
+  err.mgr.emit_message = jpeg_warning;
   *pixels = nullptr;
   if (setjmp(err.jump)) {
     std::snprintf(message, message_size, "corrupt JPEG data: %s", err.message);

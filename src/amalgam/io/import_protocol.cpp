@@ -13,14 +13,14 @@ static_assert(std::is_trivially_copyable_v<Primitive> && std::is_trivially_copya
 
 /// Names the version and the raw record sizes: a helper built from other sources says so.
 std::string hello() {
-  return "amalgam-import protocol 2: Primitive " + std::to_string(sizeof(Primitive)) +
+  return "amalgam-import protocol 3: Primitive " + std::to_string(sizeof(Primitive)) +
          ", Surface " + std::to_string(sizeof(Surface)) + ", Bbox " + std::to_string(sizeof(Bbox)) +
          ", TexCoords " + std::to_string(sizeof(TexCoords)) + ", Camera " +
          std::to_string(sizeof(Camera)) + ", Light " + std::to_string(sizeof(Light));
 }
 
 constexpr std::uint64_t kMaxString = std::uint64_t{1} << 24;
-constexpr int kCounts = 9;
+constexpr int kCounts = 10;
 
 bool send_string(int fd, const std::string& s) {
   const std::uint64_t n = s.size();
@@ -39,8 +39,9 @@ bool read_string(int fd, std::string& s) {
 bool send_mesh(int fd, const ImportedMesh& m) {
   const std::uint8_t status = 0;
   const std::uint64_t counts[kCounts] = {
-      m.triangles.size(), m.materials.size(), m.dropped_degenerate, m.warnings.size(), m.uvs.size(),
-      m.textures.size(),  m.cameras.size(),   m.lights.size(),      m.dropped.size()};
+      m.triangles.size(), m.materials.size(),    m.dropped_degenerate, m.warnings.size(),
+      m.uvs.size(),       m.textures.size(),     m.cameras.size(),     m.lights.size(),
+      m.dropped.size(),   m.texture_files.size()};
   if (!send_string(fd, hello()) || !write_all(fd, &status, 1) ||
       !write_all(fd, counts, sizeof counts) ||
       !write_all(fd, m.triangles.data(), m.triangles.size() * sizeof(Primitive)) ||
@@ -59,7 +60,7 @@ bool send_mesh(int fd, const ImportedMesh& m) {
   }
   for (const NamedCamera& c : m.cameras)
     if (!send_string(fd, c.name) || !write_all(fd, &c.camera, sizeof c.camera)) return false;
-  for (const auto* lines : {&m.warnings, &m.dropped})
+  for (const auto* lines : {&m.warnings, &m.dropped, &m.texture_files})
     for (const std::string& w : *lines)
       if (!send_string(fd, w)) return false;
   return true;
@@ -89,7 +90,8 @@ Reply receive(int fd, std::uint64_t max_triangles) {
   if (status != 0 || !read_all(fd, counts, sizeof counts) || counts[0] > max_triangles ||
       counts[1] > (std::uint64_t{1} << 32) || counts[3] > kMaxString ||
       (counts[4] != 0 && counts[4] != counts[0]) || counts[5] > kMaxTextures ||
-      counts[6] > kMaxString || counts[7] > kMaxString || counts[8] > kMaxString)
+      counts[6] > kMaxString || counts[7] > kMaxString || counts[8] > kMaxString ||
+      counts[9] > kMaxTextures)
     return r;
   ImportedMesh& m = r.mesh;
   m.triangles.resize(counts[0]);
@@ -127,10 +129,13 @@ Reply receive(int fd, std::uint64_t max_triangles) {
     if (!read_string(fd, c.name) || !read_all(fd, &c.camera, sizeof c.camera)) return r;
     m.cameras.push_back(std::move(c));
   }
-  for (std::uint64_t i = 0; i < counts[3] + counts[8]; ++i) {
+  for (std::uint64_t i = 0; i < counts[3] + counts[8] + counts[9]; ++i) {
     std::string w;
     if (!read_string(fd, w)) return r;
-    (i < counts[3] ? m.warnings : m.dropped).push_back(std::move(w));
+    (i < counts[3]               ? m.warnings
+     : i < counts[3] + counts[8] ? m.dropped
+                                 : m.texture_files)
+        .push_back(std::move(w));
   }
   // Texture indices the receiver trusts (ExplicitHierarchy::surface_at checks them again).
   for (Surface& s : m.materials)

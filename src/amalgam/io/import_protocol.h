@@ -5,11 +5,11 @@
 /// A reply is: a hello string naming the protocol version and the sizes of the raw records,
 /// then a status byte (0: a mesh, 1: an InputError's message). A mesh follows as the counts of
 /// triangles, materials, dropped triangles, warnings, texture coordinates, textures, cameras,
-/// lights and dropped-feature lines; the raw arrays (Primitive, Surface, TexCoords, Light and
-/// Bbox are trivially copyable, and both ends are built together); each texture as its width,
-/// height (32 bits each), wrap modes (a byte each) and RGB bytes; each camera as its name and raw
-/// Camera; then the warnings and the dropped-feature lines. An error follows as its message.
-/// Strings are a 64-bit length and the bytes.
+/// lights, dropped-feature lines and texture files; the raw arrays (Primitive, Surface, TexCoords,
+/// Light and Bbox are trivially copyable, and both ends are built together); each texture as its
+/// width, height (32 bits each), wrap modes (a byte each) and RGB bytes; each camera as its name
+/// and raw Camera; then the warnings, the dropped-feature lines and the texture files read. An
+/// error follows as its message. Strings are a 64-bit length and the bytes.
 
 #include <cstdint>
 #include <string>

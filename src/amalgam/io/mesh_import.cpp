@@ -6,14 +6,21 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
+#include <chrono>
+#include <condition_variable>
 #include <cstdlib>
 #include <filesystem>
+#include <mutex>
+#include <sstream>
+#include <stop_token>
 #include <system_error>
+#include <thread>
 #include <vector>
 
 #include "amalgam/io/import_protocol.h"
-#include "amalgam/io/mesh_header_check.h"
+#include "amalgam/io/mesh_check.h"
 #include "amalgam/util/error.h"
 
 extern char** environ;
@@ -55,14 +62,18 @@ std::string find_helper(const ImportConfig& config) {
 /// destructor kills (SIGKILL) and reaps it, so no failure on our side leaves it running.
 class Helper {
  public:
-  Helper(const std::string& helper, const std::string& path, const ImportConfig& config) {
+  Helper(const std::string& helper, const std::string& path, const ImportConfig& config,
+         std::chrono::duration<double> timeout) {
     int fds[2];
     if (::pipe2(fds, O_CLOEXEC) != 0)
       throw RuntimeError(helper + ": cannot start the mesh importer: " + errno_text(errno));
     const std::string parent = std::to_string(::getpid());
     const std::string max = std::to_string(config.max_triangles);
-    std::vector<std::string> args = {helper, "--parent", parent, "--max-triangles",
-                                     max,    "--",       path};
+    std::vector<std::string> args = {helper, "--parent", parent, "--max-triangles", max};
+    if (config.max_bytes != 0)
+      args.insert(args.end(), {"--max-bytes", std::to_string(config.max_bytes), "--limit-name",
+                               config.limit_name});
+    args.insert(args.end(), {"--", path});
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -92,10 +103,22 @@ class Helper {
       throw RuntimeError(helper + ": cannot start the mesh importer: " + errno_text(err));
     }
     fd_ = fds[0];
+    // The watchdog: at the deadline the helper is killed, its pipe ends, the reply is broken.
+    watchdog_ = std::jthread([this, timeout](std::stop_token stop) {
+      std::mutex m;
+      std::condition_variable_any cv;
+      std::unique_lock lock(m);
+      cv.wait_for(lock, stop, timeout, [] { return false; });
+      if (!stop.stop_requested()) {
+        timed_out_ = true;
+        ::kill(pid_, SIGKILL);
+      }
+    });
   }
   Helper(const Helper&) = delete;
   Helper& operator=(const Helper&) = delete;
   ~Helper() {
+    stop_watchdog();
     if (fd_ >= 0) ::close(fd_);
     if (!reaped_) {
       ::kill(pid_, SIGKILL);
@@ -104,10 +127,13 @@ class Helper {
   }
 
   int fd() const { return fd_; }
+  /// Whether the watchdog killed the helper (valid once reap() returned).
+  bool timed_out() const { return timed_out_; }
 
   /// Closes the pipe and waits for the helper to end; its wait status. With `kill`, ends it
   /// first (after a reply that cannot be read, it may still be running).
   int reap(bool kill) {
+    stop_watchdog();
     ::close(fd_);
     fd_ = -1;
     if (kill) ::kill(pid_, SIGKILL);
@@ -116,6 +142,13 @@ class Helper {
   }
 
  private:
+  /// Before the helper is reaped (its pid may then be reused), so it is never killed after.
+  void stop_watchdog() {
+    if (watchdog_.joinable()) {
+      watchdog_.request_stop();
+      watchdog_.join();
+    }
+  }
   int wait() const {
     int status = 0;
     while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
@@ -126,7 +159,31 @@ class Helper {
   pid_t pid_ = -1;
   int fd_ = -1;
   bool reaped_ = false;
+  std::atomic<bool> timed_out_ = false;
+  std::jthread watchdog_;  // last: stopped (destructor) before the members it reads go
 };
+
+/// ImportConfig::timeout_seconds, else AMALGAM_IMPORT_TIMEOUT, else 300 s + 1 s per MiB.
+double timeout_seconds(const std::string& path, const ImportConfig& config) {
+  if (config.timeout_seconds > 0) return config.timeout_seconds;
+  if (const char* env = std::getenv("AMALGAM_IMPORT_TIMEOUT"); env != nullptr && *env != '\0') {
+    char* end = nullptr;
+    const double s = std::strtod(env, &end);
+    if (*end != '\0' || !(s > 0) || !(s <= 1e7))
+      throw InputError(std::string("AMALGAM_IMPORT_TIMEOUT=") + one_line(env) +
+                       ": expected seconds, a number in (0, 1e7]");
+    return s;
+  }
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  return 300.0 + (ec ? 0.0 : static_cast<double>(size) / (1 << 20));
+}
+
+std::string seconds_text(double s) {
+  std::ostringstream out;
+  out << s << " s";
+  return out.str();
+}
 
 [[noreturn]] void crashed(const std::string& path, int status) {
   const std::string why = WIFSIGNALED(status)
@@ -141,14 +198,18 @@ ImportedMesh import_mesh(const std::string& path, const ImportConfig& config) {
   std::error_code ec;
   if (!fs::exists(path, ec)) fail_input(path, "no such file");
   if (!fs::is_regular_file(path, ec)) fail_input(path, "not a regular file");
-  check_mesh_header(path);
+  check_mesh_file(path);
 
   const std::string helper_path = find_helper(config);
-  Helper helper(helper_path, path, config);
+  const double timeout = timeout_seconds(path, config);
+  Helper helper(helper_path, path, config, std::chrono::duration<double>(timeout));
   import_protocol::Reply reply = import_protocol::receive(helper.fd(), config.max_triangles);
   using Kind = import_protocol::Reply::Kind;
   const int status =
       helper.reap(/*kill=*/reply.kind == Kind::kBroken || reply.kind == Kind::kIncompatible);
+  if (helper.timed_out())
+    fail_input(path, "the importer did not finish within " + seconds_text(timeout) +
+                         " (is the file corrupt? AMALGAM_IMPORT_TIMEOUT sets the limit)");
   switch (reply.kind) {
     case Kind::kError:
       throw InputError(reply.error);

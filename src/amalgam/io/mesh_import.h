@@ -31,12 +31,24 @@ struct ImportedMesh {
   /// What the file holds that is not rendered (a spot light, emission, a texture that cannot
   /// be read, ...), one line each, naming it: for the user (the CLI prints them).
   std::vector<std::string> dropped;
+  /// The texture files read (beside the mesh, as resolved): inputs, like the mesh itself, that
+  /// an output must never replace (the CLI checks).
+  std::vector<std::string> texture_files;
 };
 
 /// Settings for `import_mesh`.
 struct ImportConfig {
   /// More triangles than this is an InputError (before any are copied).
   std::uint64_t max_triangles = 50'000'000;
+  /// Bytes the helper may allocate (its RLIMIT_DATA; 0: no limit): an import that needs more
+  /// is an InputError naming `limit_name` ("the importer ran out of memory under ..."). Not
+  /// applied in a build under AddressSanitizer, whose shadow memory counts against the limit.
+  std::uint64_t max_bytes = 0;
+  std::string limit_name = "the memory limit";
+  /// Seconds the helper may take from its start to the end of its reply, after which it is
+  /// killed and the import is an InputError. 0: the environment variable
+  /// AMALGAM_IMPORT_TIMEOUT (seconds) if set, else 300 s plus 1 s per MiB of the file.
+  double timeout_seconds = 0;
   /// The helper executable that runs Assimp. Empty: the environment variable
   /// AMALGAM_IMPORT_HELPER if set and not empty, else `amalgam-import` in the directory of the
   /// running executable (/proc/self/exe) if it is there, else the one of the build tree
@@ -54,9 +66,10 @@ struct ImportConfig {
 /// file, when it reports corrupt data it repaired (faces with out-of-range or missing indices,
 /// vertex counts that do not fit the primitive mode), when a vertex is NaN or infinite, when
 /// no triangle with non-zero area is left, or when the importer crashes on it ("the importer
-/// crashed on this file (signal N); is it corrupt?"). Throws RuntimeError when the helper
-/// cannot be found or started, or is not a compatible build. Never prints: Assimp's logger
-/// stays silent and the helper's stderr goes to /dev/null. Thread-safe: concurrent imports
+/// crashed on this file (signal N); is it corrupt?"), when it runs out of `max_bytes` or
+/// time (ImportConfig), or when check_mesh_file (io/mesh_check.h) refuses it. Throws RuntimeError
+/// when the helper cannot be found or started, or is not a compatible build. Never prints: Assimp's
+/// logger stays silent and the helper's stderr goes to /dev/null. Thread-safe: concurrent imports
 /// run in separate helpers. A helper never outlives the process that started it.
 ImportedMesh import_mesh(const std::string& path, const ImportConfig& config = {});
 

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <iomanip>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -298,8 +297,7 @@ class SceneParser {
       auto cached = imported_.find(full.string());
       if (cached == imported_.end()) {
         try {
-          ImportConfig ic;
-          ic.max_triangles = config_.max_triangles;
+          const ImportConfig ic = import_config(config_);
           cached =
               imported_
                   .emplace(full.string(),
@@ -310,7 +308,10 @@ class SceneParser {
         }
       }
       e.mesh = cached->second;
-      if (warned_.insert(full.string()).second) {
+      if (warned_.insert(full.string()).second) {  // once per mesh file
+        out_.inputs.push_back(full.string());
+        out_.inputs.insert(out_.inputs.end(), e.mesh->texture_files.begin(),
+                           e.mesh->texture_files.end());
         out_.warnings.insert(out_.warnings.end(), e.mesh->dropped.begin(), e.mesh->dropped.end());
         if (!e.mesh->cameras.empty() || !e.mesh->lights.empty())
           out_.warnings.push_back(full.string() +
@@ -457,22 +458,6 @@ std::size_t first_invalid_utf8(const std::string& s) {
 }
 
 }  // namespace
-
-std::string format_bytes(double b) {
-  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
-  int u = 0;
-  while (b >= 1024 && u < 4) b /= 1024, ++u;
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(u ? 1 : 0) << b << " " << units[u];
-  return s.str();
-}
-
-void check_memory(const std::string& where, std::uint64_t need, const SceneFileConfig& config) {
-  if (config.max_bytes == 0 || need <= config.max_bytes) return;
-  throw InputError(where + ": the scene needs about " + format_bytes(static_cast<double>(need)) +
-                   " (estimated before building, within about 25 %), more than " +
-                   config.limit_name);
-}
 
 SceneDescription parse_scene_json(const std::string& text, const std::string& path,
                                   const SceneFileConfig& config) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "amalgam/hierarchy/volume/cells.h"
+#include "amalgam/io/mesh_import.h"
 #include "amalgam/scene/description.h"
 #include "amalgam/util/error.h"
 
@@ -36,10 +37,18 @@ struct SceneFileConfig {
   /// message (e.g. "--max-memory 100 MiB less the film").
   std::uint64_t max_bytes = 0;
   std::string limit_name = "the memory limit";
+  /// Bytes the mesh import helper may allocate (ImportConfig::max_bytes; 0: no limit): a
+  /// separate process, done before the scene is built, so held to the whole memory limit;
+  /// `import_limit_name` names it.
+  std::uint64_t import_max_bytes = 0;
+  std::string import_limit_name = "the memory limit";
   /// Called as loading enters each phase ("reading scene.json", "building and baking
   /// scene.json"), e.g. for a status line or an out-of-memory message. Optional.
   std::function<void(const std::string&)> on_phase;
 };
+
+/// The settings import_mesh gets for the meshes of a scene loaded with `config`.
+ImportConfig import_config(const SceneFileConfig& config);
 
 /// "12.3 MiB": a byte count for messages.
 std::string format_bytes(double bytes);

@@ -1,9 +1,13 @@
 #include "amalgam/io/scene_json_parts.h"
 
 #include <cmath>
+#include <iomanip>
 #include <numbers>
+#include <sstream>
 #include <string>
 #include <vector>
+
+#include "amalgam/io/scene_json.h"
 
 namespace amalgam::scene_json {
 
@@ -195,3 +199,31 @@ ScatterPattern read_scatter(const JsonReader& r, const JsonValue& v) {
 }
 
 }  // namespace amalgam::scene_json
+
+namespace amalgam {
+
+ImportConfig import_config(const SceneFileConfig& config) {
+  ImportConfig ic;
+  ic.max_triangles = config.max_triangles;
+  ic.max_bytes = config.import_max_bytes;
+  ic.limit_name = config.import_limit_name;
+  return ic;
+}
+
+std::string format_bytes(double b) {
+  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
+  int u = 0;
+  while (b >= 1024 && u < 4) b /= 1024, ++u;
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(u ? 1 : 0) << b << " " << units[u];
+  return s.str();
+}
+
+void check_memory(const std::string& where, std::uint64_t need, const SceneFileConfig& config) {
+  if (config.max_bytes == 0 || need <= config.max_bytes) return;
+  throw InputError(where + ": the scene needs about " + format_bytes(static_cast<double>(need)) +
+                   " (estimated before building, within about 25 %), more than " +
+                   config.limit_name);
+}
+
+}  // namespace amalgam

@@ -37,9 +37,7 @@ AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config) {
 }
 
 SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& config) {
-  ImportConfig ic;
-  ic.max_triangles = config.max_triangles;
-  ImportedMesh m = import_mesh(path, ic);
+  ImportedMesh m = import_mesh(path, import_config(config));
   check_extent(m.bounds, path);
   std::uint64_t texture_bytes = m.uvs.size() * sizeof(TexCoords) * 2;  // as read, and built
   for (const Texture& t : m.textures) texture_bytes += t.texels.size();
@@ -57,6 +55,7 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
   d.textures = std::move(m.textures);
   d.cameras = std::move(m.cameras);
   d.warnings = std::move(m.dropped);
+  d.inputs = std::move(m.texture_files);
   d.env.camera = d.cameras.empty() ? frame_camera(m.bounds) : d.cameras.front().camera;
   d.default_lights = m.lights.empty();
   d.env.lights = d.default_lights ? default_lights(m.bounds, d.env.camera) : std::move(m.lights);
@@ -75,6 +74,8 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   Environment env = std::move(d.env);
   std::vector<NamedCamera> cameras = std::move(d.cameras);
   std::vector<std::string> warnings = std::move(d.warnings);
+  std::vector<std::string> inputs = {path};
+  inputs.insert(inputs.end(), d.inputs.begin(), d.inputs.end());
   const bool defaults = d.default_lights;
   if (config.on_phase) config.on_phase("building and baking " + path);
   double bake_seconds = 0.0;
@@ -93,6 +94,7 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   }
   s.cameras = std::move(cameras);
   s.warnings = std::move(warnings);
+  s.inputs = std::move(inputs);
   s.default_lights = defaults;
   s.load_seconds = std::chrono::duration<double>(t1 - t0).count();
   s.bake_seconds = bake_seconds;

@@ -40,6 +40,9 @@ struct LoadedScene {
   bool default_lights = false;
   /// What the scene file holds that is not rendered, one line each (the CLI prints them).
   std::vector<std::string> warnings{};
+  /// The files read (the scene file, its meshes and their textures; none for a builtin): what
+  /// an output must never replace.
+  std::vector<std::string> inputs{};
 
   HierarchyInfo info() const {
     return std::visit([](const auto& h) { return h.info(); }, hierarchy);

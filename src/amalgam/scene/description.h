@@ -30,6 +30,9 @@ struct SceneDescription {
   bool default_lights = false;
   /// What the file holds that is not rendered, one line each, for the user to see.
   std::vector<std::string> warnings;
+  /// The files read besides the scene file itself (meshes, their textures): inputs that an
+  /// output must never replace.
+  std::vector<std::string> inputs;
   Environment env;
   /// Instanced meshes in object space (materials index `materials`), and their placements.
   /// Empty unless the scene is large enough to keep instances (see SceneFileConfig,
