@@ -325,6 +325,13 @@ class SceneParser {
                                 " triangles " + std::to_string(levels) + " times gives " +
                                 fmt(tris) + ", more than the limit of " +
                                 fmt(static_cast<double>(config_.max_triangles)));
+        // Before subdividing: the finer triangles alone must fit the memory limit (the whole
+        // scene is estimated once every mesh is read).
+        const double bytes = tris * static_cast<double>(sizeof(Primitive));
+        if (config_.max_bytes != 0 && bytes > static_cast<double>(config_.max_bytes))
+          r_.fail(sub->ptr, "subdividing " + std::to_string(levels) + " times gives " + fmt(tris) +
+                                " triangles, which alone take " + format_bytes(bytes) +
+                                ", more than " + config_.limit_name);
         if (levels > 0) {
           ImportedMesh fine = *e.mesh;
           fine.triangles = subdivide(e.mesh->triangles, levels);
