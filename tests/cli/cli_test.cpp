@@ -32,6 +32,14 @@ struct CliRun {
   std::string out;
 };
 
+/// The first line of a file (an error message the CLI wrote to stderr).
+std::string first_line(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  return line;
+}
+
 // Runs the binary with `args` (a shell-quoted string); stdout captured, stderr to err_file.
 CliRun run(const std::string& args, const std::string& err_file = "/dev/null") {
   const auto r =
@@ -366,9 +374,7 @@ TEST(CliLimits, MaxMemoryFailsEarlyWithAClearMessage) {
       run("render builtin:line --width 20000 --height 20000 --max-memory 100M --out " + out, err);
   EXPECT_EQ(r.status, 2);
   EXPECT_FALSE(fs::exists(out));
-  std::ifstream in(err);
-  std::string line;
-  std::getline(in, line);
+  const std::string line = first_line(err);
   EXPECT_NE(line.find("--max-memory"), std::string::npos) << line;
   EXPECT_NE(line.find("GiB"), std::string::npos) << line;
 }
@@ -390,9 +396,7 @@ TEST(CliLimits, MaxMemoryRefusesASubdivisionBeforeDoingIt) {
   EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(2));
   EXPECT_EQ(r.status, 2);
   EXPECT_FALSE(fs::exists(out));
-  std::ifstream in(err);
-  std::string line;
-  std::getline(in, line);
+  const std::string line = first_line(err);
   EXPECT_NE(line.find("/meshes/0/subdivide: subdividing 6 times gives"), std::string::npos) << line;
   EXPECT_NE(line.find("more than --max-memory 100.0 MiB"), std::string::npos) << line;
   fs::remove_all(d);
@@ -413,9 +417,7 @@ TEST(CliLimits, MaxMemoryCountsInstancedScenes) {
                        err);
   EXPECT_EQ(r.status, 2);
   EXPECT_FALSE(fs::exists(out));
-  std::ifstream in(err);
-  std::string line;
-  std::getline(in, line);
+  const std::string line = first_line(err);
   EXPECT_NE(line.find("the scene needs about"), std::string::npos) << line;
   // With room for it, the same scene renders.
   const CliRun ok = run("render " + (d / "many.json").string() +
