@@ -187,19 +187,34 @@ TEST(Formulas, Eq1Eq2Eq3) {
 }
 
 TEST(Formulas, EfficientFraction) {
-  EXPECT_DOUBLE_EQ(f::efficient_fraction(1.0, 4.0), 0.5);
-  EXPECT_DOUBLE_EQ(f::efficient_fraction(3.0, 100.0), 0.3);
-  EXPECT_DOUBLE_EQ(f::efficient_fraction_levels(1.0, 4, 2), 0.25);
-  EXPECT_DOUBLE_EQ(f::efficient_fraction_levels(2.5, 3, 4), 2.5 / 9.0);
+  EXPECT_DOUBLE_EQ(f::efficient_fraction(4.0), 0.5);
+  EXPECT_DOUBLE_EQ(f::efficient_fraction(100.0), 0.1);
+  EXPECT_DOUBLE_EQ(f::efficient_fraction_as_printed(3.0, 100.0), 0.3);
   for (int n = 2; n <= 5; ++n) {
-    for (int l = 0; l <= 10; ++l) {
-      // alpha n^{-l_max/2} = alpha sqrt(1/p) with p = n^{l_max}.
-      const double closed = 2.5 / std::sqrt(ipow(n, l));
-      EXPECT_NEAR(f::efficient_fraction_levels(2.5, n, l), closed, 1e-15) << n << " " << l;
-      EXPECT_NEAR(f::efficient_fraction(2.5, ipow(n, l)), closed, 1e-15) << n << " " << l;
+    for (int l = 0; l <= 12; l += 2) {
+      // The exact ratio of the sums, written out: sum_{i <= l/2} n^i / sum_{i <= l} n^i.
+      double half = 0, all = 0;
+      for (int i = 0; i <= l; ++i) (i <= l / 2 ? half : all) += ipow(n, i);
+      all += half;
+      EXPECT_NEAR(f::efficient_fraction_exact(n, l), half / all, 1e-15) << n << " " << l;
+      // It tends to sqrt(1/p) with p = n^{l_max} (the ratio is (1 - n^{-l/2-1})/(1 - n^{-l-1}))
+      // whatever the alpha of the printed form, which it matches for alpha = 1 only.
+      const double sqrt_1_p = f::efficient_fraction(ipow(n, l));
+      EXPECT_NEAR(f::efficient_fraction_exact(n, l) / sqrt_1_p,
+                  (1 - std::pow(n, -l / 2 - 1.0)) / (1 - std::pow(n, -l - 1.0)), 1e-12);
+      if (l >= 10) {
+        EXPECT_NEAR(f::efficient_fraction_exact(n, l) / sqrt_1_p, 1.0, 0.02) << n << " " << l;
+        for (double alpha : {0.25, 0.5, 0.9, 1.1, 2.0})
+          EXPECT_GT(std::fabs(f::efficient_fraction_as_printed(alpha, ipow(n, l)) /
+                                  f::efficient_fraction_exact(n, l) -
+                              1.0),
+                    0.05)
+              << n << " " << l << " alpha " << alpha;
+      }
     }
   }
-  EXPECT_THROW(f::efficient_fraction(1.0, 0.0), std::invalid_argument);
+  EXPECT_THROW(f::efficient_fraction(0.0), std::invalid_argument);
+  EXPECT_THROW(f::efficient_fraction_exact(2, 3), std::invalid_argument);
 }
 
 TEST(Formulas, FailedTestsWorstCase) {

@@ -118,15 +118,20 @@ std::uint64_t stochastic_total_exact(int n, int l1) {
   return checked_mul(2, power_sum_exact(n, l1));
 }
 
-double efficient_fraction(double alpha, double p) {
+double efficient_fraction(double p) {
   require(p > 0.0, "p must be > 0");
-  return alpha * std::sqrt(1.0 / p);
+  return std::sqrt(1.0 / p);
 }
 
-double efficient_fraction_levels(double alpha, int n, int l_max) {
-  require(n >= 1, "branching factor n must be >= 1");
-  require(l_max >= 0, "level must be >= 0");
-  return alpha * std::pow(static_cast<double>(n), -0.5 * l_max);
+double efficient_fraction_as_printed(double alpha, double p) {
+  return alpha * efficient_fraction(p);
+}
+
+double efficient_fraction_exact(int n, int l_max) {
+  require(n >= 2, "branching factor n must be >= 2");
+  require(l_max >= 0 && l_max % 2 == 0, "l_max must be even and >= 0");
+  const double m = n;
+  return (std::pow(m, l_max / 2 + 1) - 1.0) / (std::pow(m, l_max + 1) - 1.0);
 }
 
 // --- "A Second Look" ------------------------------------------------------------------------

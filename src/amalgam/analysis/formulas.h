@@ -14,7 +14,11 @@
 /// printed expressions with that reading and nothing else changed.
 ///
 /// Findings (derived by hand below, checked numerically in tests/analysis/formulas_test.cpp):
-///  * C_t0, Eqs. 1, 2, 3, 5, 6 and the efficient fraction alpha sqrt(1/p) are right.
+///  * C_t0, Eqs. 1, 2, 3, 5 and 6 are right.
+///  * The efficient fraction is wrong as printed: alpha n^{l_max/2} / (alpha n^{l_max}) is
+///    n^{-l_max/2} = sqrt(1/p), not alpha sqrt(1/p) (the alphas cancel; the printed form holds
+///    for alpha = 1 only). Exactly, it is the ratio of two sums of the same kind,
+///    (n^{l_max/2+1} - 1)/(n^{l_max+1} - 1) -> n^{-l_max/2}.
 ///  * "A Second Look" worst-case count: the printed summand n^{l_1} + m n^{l_1-1} is a typo
 ///    for n^i + m n^{i-1} (failed_tests_worst implements the corrected count).
 ///  * Eq. 9 (the printed closed form of E[i]) is algebraically exact: it equals
@@ -73,12 +77,15 @@ std::uint64_t stochastic_total_exact(int n, int l1);
 
 /// The "efficient" fraction of the database (unnumbered, after Eq. 2): with l_1 = l_max/2 the
 /// efficiently renderable part holds alpha n^{l_max/2} of alpha n^{l_max} objects, i.e. the
-/// fraction alpha n^{-l_max/2} = alpha sqrt(1/p) for p = n^{l_max}. Requires p > 0.
-double efficient_fraction(double alpha, double p);
+/// fraction n^{-l_max/2} = sqrt(1/p) for p = n^{l_max} (the alphas cancel). Requires p > 0.
+double efficient_fraction(double p);
 
-/// The same fraction written in levels, alpha n^{-l_max/2}; equals
-/// efficient_fraction(alpha, n^{l_max}).
-double efficient_fraction_levels(double alpha, int n, int l_max);
+/// The fraction as printed, alpha sqrt(1/p): wrong unless alpha = 1. Requires p > 0.
+double efficient_fraction_as_printed(double alpha, double p);
+
+/// The fraction exactly, as the ratio of the counts it stands for: C_s0 at l1 = l_max/2 (l_max
+/// even) over C_t0, (n^{l_max/2+1} - 1)/(n^{l_max+1} - 1) (n >= 2, l_max >= 0 even).
+double efficient_fraction_exact(int n, int l_max);
 
 // ---------------------------------------------------------------------------------------------
 // "A Second Look": failed intersection tests
