@@ -196,6 +196,11 @@ std::string statements_table(const std::vector<ex::Check>& checks,
       o << (i ? ", " : "") << "[" << st.experiments[i] << "](#" << st.experiments[i] << ")";
     o << " |\n";
   }
+  o << "\nPrinted slips (of the text, not of the analysis: no measurement bears on them; each is "
+       "read as meant throughout):\n\n"
+       "| where | printed | meant |\n|---|---|---|\n";
+  for (const ex::PrintedSlip& slip : ex::printed_slips())
+    o << "| " << slip.where << " | " << slip.printed << " | " << slip.meant << " |\n";
   return o.str();
 }
 

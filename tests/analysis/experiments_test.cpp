@@ -454,6 +454,11 @@ TEST(ExperimentCli, OutWritesCsvPlotAndReportForEveryExperiment) {
   fs::remove(out_txt);
   const std::string report = slurp(d / "report.md");
   EXPECT_EQ(report.rfind("# Thompson & Fussell (1991)", 0), 0u) << report.substr(0, 200);
+  // The printed slips that no measurement refutes are listed after the statements.
+  const std::size_t slips = report.find("\nPrinted slips");
+  ASSERT_NE(slips, std::string::npos);
+  for (const char* printed : {"(C_0)", "Equations 3 and 12", "in both the best case and"})
+    EXPECT_NE(report.find(printed, slips), std::string::npos) << printed;
   std::set<std::string> expected_files = {"report.md"};
   for (const std::string& name : experiments::names()) {
     SCOPED_TRACE(name);

@@ -106,6 +106,17 @@ struct Statement {
 /// hand derivations of each are in docs/paper-derivations.md).
 const std::vector<Statement>& statements();
 
+/// A slip of the printed text that no measurement can refute: a symbol, a cross-reference or a
+/// summary that says something other than what the paper means or shows.
+struct PrintedSlip {
+  std::string where;    ///< the section or paragraph
+  std::string printed;  ///< the printed words
+  std::string meant;    ///< what the paper means or shows, and why
+};
+
+/// The report's list of printed slips (after the statements; docs/paper-derivations.md too).
+const std::vector<PrintedSlip>& printed_slips();
+
 struct ExperimentResult {
   std::string name;                          ///< e.g. "worst-traditional"
   std::string title;                         ///< section heading

@@ -82,4 +82,24 @@ const std::vector<Statement>& statements() {
   return s;
 }
 
+const std::vector<PrintedSlip>& printed_slips() {
+  static const std::vector<PrintedSlip> s = {
+      {"Worst case, stochastic opacity (before Eq. 3)",
+       "the shadow ray \"has the same, low cost as the primary ray (C_0)\"",
+       "C_s0: the primary ray's cost through level l1 (Eq. 1); no C_0 is defined"},
+      {"Expected case, scale-sensitive renderer (after Eq. 12)",
+       "\"the time cost closely resembles Equations 3 and 12\"",
+       "Equations 10 and 12: Eq. 3 is the worst-case stochastic total; the expected-case "
+       "expressions with n for p/b are Eq. 10 and its limit, Eq. 12"},
+      {"Abstract",
+       "ray tracers with amalgams \"arguably have better asymptotic time complexity -- in both "
+       "the best case and the expected case\"",
+       "the body shows a better worst case (O(n^{l1}) against O(p)) and equal expected cases "
+       "(O(log b) and O(log p) are the same order when l1 is a fixed number of levels above "
+       "the bottom); the conclusions say so: \"Expected asymptotic costs ... are the same\", "
+       "\"better worst case asymptotic costs\""},
+  };
+  return s;
+}
+
 }  // namespace amalgam::experiments
