@@ -54,8 +54,7 @@ class MemberCheck : public nlohmann::json_sax<nlohmann::json> {
     std::string key;
   };
 
-  /// Before a value in the current container: nothing to do for an object (its key is set);
-  /// an array counts its elements.
+  /// A container starts: it is a value of its parent, then the innermost level of the path.
   void open(bool array) {
     before_value();
     path_.push_back(Level{array, 0, {}});
@@ -64,6 +63,8 @@ class MemberCheck : public nlohmann::json_sax<nlohmann::json> {
     path_.pop_back();
     return true;
   }
+  /// Before a value in the current container: nothing to do for an object (its key is set);
+  /// an array counts its elements.
   void before_value() {
     if (!path_.empty() && path_.back().array) ++path_.back().index;
   }
