@@ -19,7 +19,8 @@ case "$mode" in
 esac
 packages=(
   build-essential cmake ninja-build pkg-config
-  libtbb-dev libpng-dev libjpeg62-turbo-dev libopenexr-dev nlohmann-json3-dev libcli11-dev
+  libtbb-dev libpng-dev libjpeg62-turbo-dev libopenexr-dev libstb-dev nlohmann-json3-dev
+  libcli11-dev
   libassimp-dev assimp-testmodels libembree-dev
   python3 python3-matplotlib python3-numpy
 )

@@ -17,8 +17,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-}
-targets=(scene_json params mesh checkpoint)
-declare -A runs_ci=([scene_json]=5000 [params]=6000 [mesh]=400 [checkpoint]=5000)
+targets=(scene_json params mesh checkpoint image)
+declare -A runs_ci=([scene_json]=5000 [params]=6000 [mesh]=400 [checkpoint]=5000 [image]=5000)
 if [ "$seconds" = --long ]; then
   seconds=""
   targets=(mesh)

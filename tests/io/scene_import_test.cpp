@@ -357,9 +357,9 @@ TEST(Texture, ObjCorruptJpegAndMissingCoordinatesWarnAndRender) {
 }
 
 // Textures are hostile input too: an image that claims 65535 x 65535 texels (refused from
-// its header, before any texel is allocated), a PNG and a JPEG cut in half, a TGA (not
-// decoded): each is one warning naming it, its material renders with its colour, the rest
-// of the mesh imports, quickly.
+// its header, before any texel is allocated), a PNG, a JPEG and a TGA cut in half (each
+// decoder would fill the rest in), a file in no image format: each is one warning naming it,
+// its material renders with its colour, the rest of the mesh imports, quickly.
 TEST(Texture, HostileAndTruncatedImagesAreOneWarningEachAndTheColour) {
   REQUIRE_GLTF_MODELS();
   const fs::path d = scratch_dir() / "hostile";
@@ -377,12 +377,11 @@ TEST(Texture, HostileAndTruncatedImagesAreOneWarningEachAndTheColour) {
   };
   write(d / "half.png", half_of(kGltf / "BoxTextured-glTF/CesiumLogoFlat.png"));
   write(d / "half.jpg", half_of("/usr/share/assimp/models/OBJ/SpiderTex.jpg"));
-  // An uncompressed 2 x 2 true-colour TGA: a valid image in a format not decoded.
-  write(d / "image.tga",
-        std::string("\0\0\2\0\0\0\0\0\0\0\0\0\2\0\2\0\x18\0", 18) + std::string(12, '\x7f'));
+  write(d / "half.tga", half_of("/usr/share/assimp/models/Collada/duckCM.tga"));
+  write(d / "notes.txt", "a text file named as a texture\n");
   std::string mtl, obj = "mtllib m.mtl\nvt 0 0\nvt 1 0\nvt 0 1\n";
-  const char* images[] = {"huge.png", "half.png", "half.jpg", "image.tga"};
-  for (int i = 0; i < 4; ++i) {
+  const char* images[] = {"huge.png", "half.png", "half.jpg", "half.tga", "notes.txt"};
+  for (int i = 0; i < 5; ++i) {
     mtl += "newmtl m" + std::to_string(i) + "\nKd 0.5 0.25 " + std::to_string(0.2 * (i + 1)) +
            "\nmap_Kd " + images[i] + "\n";
     obj += "v " + std::to_string(2 * i) + " 0 0\nv " + std::to_string(2 * i + 1) + " 0 0\nv " +
@@ -395,7 +394,7 @@ TEST(Texture, HostileAndTruncatedImagesAreOneWarningEachAndTheColour) {
   const auto t0 = std::chrono::steady_clock::now();
   const ImportedMesh m = import_mesh((d / "a.obj").string());
   EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(10));
-  ASSERT_EQ(m.triangles.size(), 4u);
+  ASSERT_EQ(m.triangles.size(), 5u);
   for (const Primitive& t : m.triangles) {
     const Surface& s = m.materials[t.material];
     EXPECT_EQ(s.texture, -1);
@@ -406,6 +405,8 @@ TEST(Texture, HostileAndTruncatedImagesAreOneWarningEachAndTheColour) {
   for (const char* image : images)
     EXPECT_NE(all.find(std::string("'") + image + "'"), std::string::npos) << image << "\n" << all;
   EXPECT_NE(all.find("65535x65535 texels"), std::string::npos) << all;
+  EXPECT_NE(all.find("ends before its texels do"), std::string::npos) << all;
+  EXPECT_NE(all.find("not an image format amalgam reads"), std::string::npos) << all;
 }
 
 TEST(GltfCamera, TheFirstPerspectiveCameraAsTheFileGivesIt) {

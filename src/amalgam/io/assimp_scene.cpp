@@ -111,10 +111,11 @@ bool read_bytes(const fs::path& p, std::uintmax_t limit, std::vector<std::uint8_
 }
 
 /// Loads the texture `ref` of the mesh at `path` (embedded, or a file beside the mesh).
-/// A texture file found is recorded in `files`, read or not.
+/// A texture file found is recorded in `files`, read or not; `by_name` is set when it was found
+/// by its file name alone, beside the mesh, and not where `ref` says.
 bool load_texture(const aiScene& scene, const std::string& path, const std::string& ref,
                   std::uint64_t budget, Texture& t, std::string& why,
-                  std::vector<std::string>& files) {
+                  std::vector<std::string>& files, bool& by_name) {
   const std::uint64_t max_texels = budget / 3;
   const auto side = import_protocol::kMaxTextureSide;
   if (const aiTexture* e = scene.GetEmbeddedTexture(ref.c_str())) {
@@ -140,16 +141,20 @@ bool load_texture(const aiScene& scene, const std::string& path, const std::stri
     return false;
   }
   // As written; with Windows separators turned round (".\\tex.jpg" in many OBJ files); and
-  // the file name alone, beside the mesh.
+  // the file name alone, beside the mesh (an absolute path from another machine, such as
+  // "D:\\models\\wood.jpg", or a folder that was not copied along).
   const fs::path dir = fs::path(path).parent_path();
   std::string slashed = ref;
   std::replace(slashed.begin(), slashed.end(), '\\', '/');
   fs::path file;
-  for (const fs::path& p : {fs::path(ref), fs::path(slashed), fs::path(slashed).filename()}) {
-    file = p.is_absolute() ? p : dir / p;
+  by_name = false;
+  const fs::path tries[3] = {fs::path(ref), fs::path(slashed), fs::path(slashed).filename()};
+  for (int i = 0; i < 3; ++i) {
+    file = tries[i].is_absolute() ? tries[i] : dir / tries[i];
     std::error_code ec;
     if (fs::is_regular_file(file, ec)) {
       files.push_back(file.string());
+      by_name = i == 2 && tries[2] != tries[1];
       break;
     }
   }
@@ -381,7 +386,12 @@ std::vector<unsigned> read_materials(const aiScene& scene, const std::string& pa
           Texture t;
           std::string why;
           std::int32_t index = -1;
-          if (load_texture(scene, path, ref.C_Str(), budget, t, why, out.texture_files)) {
+          bool by_name = false;
+          const bool read =
+              load_texture(scene, path, ref.C_Str(), budget, t, why, out.texture_files, by_name);
+          if (by_name)
+            notes.add("textures not where the file says, read by file name beside it", quoted(ref));
+          if (read) {
             budget -= t.texels.size();
             t.wrap_u = wrap_u, t.wrap_v = wrap_v;
             index = static_cast<std::int32_t>(out.textures.size());

@@ -5,11 +5,29 @@
 #include <jpeglib.h>
 #include <jerror.h>  // after jpeglib.h: the warning codes (JWRN_*)
 // clang-format on
+#include <Iex.h>
+#include <OpenEXR/ImfIO.h>
+#include <OpenEXR/ImfRgbaFile.h>
 #include <png.h>
 
+#include <algorithm>
 #include <csetjmp>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
+#include <memory>
+
+#include "amalgam/io/srgb.h"
+
+// stb_image (Debian's libstb-dev) for the formats without a stricter library here: libpng
+// checks every chunk's CRC and libjpeg reports a file cut short, where stb_image decodes both
+// silently, so PNG and JPEG stay with them.
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_NO_STDIO
+#define STBI_NO_PNG
+#define STBI_NO_JPEG
+#define STBI_MAX_DIMENSIONS (1 << 16)
+#include <stb/stb_image.h>
 
 namespace amalgam {
 namespace {
@@ -150,6 +168,141 @@ bool decode_jpeg(const std::uint8_t* data, std::size_t size, std::uint64_t max_t
   return true;
 }
 
+/// An EXR file in memory, as OpenEXR reads it (a read past the end throws, as from a file).
+class MemoryStream final : public Imf::IStream {
+ public:
+  MemoryStream(const std::uint8_t* data, std::size_t size)
+      : Imf::IStream("texture"), data_(data), size_(size) {}
+  bool read(char c[], int n) override {
+    if (n < 0 || static_cast<std::size_t>(n) > size_ - pos_)
+      throw Iex::InputExc("the file is shorter than its header says");
+    std::memcpy(c, data_ + pos_, static_cast<std::size_t>(n));
+    pos_ += static_cast<std::size_t>(n);
+    return pos_ < size_;
+  }
+  std::uint64_t tellg() override { return pos_; }
+  void seekg(std::uint64_t pos) override {
+    if (pos > size_) throw Iex::InputExc("a seek past the end of the file");
+    pos_ = static_cast<std::size_t>(pos);
+  }
+
+ private:
+  const std::uint8_t* data_;
+  std::size_t size_, pos_ = 0;
+};
+
+/// EXR through OpenEXR's RGBA interface (any channel type; luminance-only files as grey):
+/// linear colours, stored as 8-bit sRGB like every texture (clamped to [0, 1], as a base colour
+/// is a reflectance).
+bool decode_exr(const std::uint8_t* data, std::size_t size, std::uint64_t max_texels,
+                std::uint32_t max_side, Texture& out, std::string& why) {
+  try {
+    MemoryStream stream(data, size);
+    Imf::RgbaInputFile file(stream, 1);
+    const Imath::Box2i win = file.dataWindow();
+    const std::int64_t w = std::int64_t{win.max.x} - win.min.x + 1;
+    const std::int64_t h = std::int64_t{win.max.y} - win.min.y + 1;
+    if (w <= 0 || h <= 0) {
+      why = "the image is empty";
+      return false;
+    }
+    if (too_large(static_cast<std::uint64_t>(w), static_cast<std::uint64_t>(h), max_texels,
+                  max_side, why))
+      return false;
+    std::vector<Imf::Rgba> pixels(static_cast<std::size_t>(w * h));
+    file.setFrameBuffer(pixels.data() - win.min.x - win.min.y * w, 1, static_cast<std::size_t>(w));
+    file.readPixels(win.min.y, win.max.y);
+    out.width = static_cast<std::uint32_t>(w), out.height = static_cast<std::uint32_t>(h);
+    out.texels.resize(3 * pixels.size());
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+      out.texels[3 * i] = encode_srgb8(pixels[i].r);
+      out.texels[3 * i + 1] = encode_srgb8(pixels[i].g);
+      out.texels[3 * i + 2] = encode_srgb8(pixels[i].b);
+    }
+    return true;
+  } catch (const std::exception& e) {
+    why = std::string("corrupt EXR data: ") + e.what();
+    return false;
+  }
+}
+
+/// The bytes of an image for stb_image's reader, which notes a read past the end: stb_image
+/// reads missing bytes as zeros and returns success, so a file cut short would be a silently
+/// black texture. Files under stb_image's 128-byte buffer are served padded with zeros to it
+/// (its format tests read up to that far); a read past data and padding is the overrun.
+struct StbSource {
+  const std::uint8_t* data;
+  std::size_t size, pos = 0;
+  bool overrun = false;
+  std::size_t served() const { return std::max<std::size_t>(size, 128); }
+
+  static int read(void* user, char* out, int n) {
+    auto* s = static_cast<StbSource*>(user);
+    if (s->pos >= s->served() && n > 0) s->overrun = true;
+    const std::size_t k = std::min(static_cast<std::size_t>(std::max(n, 0)), s->served() - s->pos);
+    for (std::size_t i = 0; i < k; ++i, ++s->pos)
+      out[i] = static_cast<char>(s->pos < s->size ? s->data[s->pos] : 0);
+    return static_cast<int>(k);
+  }
+  static void skip(void* user, int n) {
+    auto* s = static_cast<StbSource*>(user);
+    const std::size_t to = s->pos + static_cast<std::size_t>(std::max(n, 0));
+    if (n < 0 || to > s->served()) s->overrun = n > 0;
+    s->pos = std::min(n < 0 ? s->pos : to, s->served());
+  }
+  static int eof(void* user) {
+    auto* s = static_cast<StbSource*>(user);
+    return s->pos >= s->served() ? 1 : 0;
+  }
+};
+
+/// TGA, BMP, PSD, GIF (first frame), HDR (Radiance), PIC and PNM through stb_image; HDR is
+/// linear, stored as 8-bit sRGB as an EXR is. A file shorter than its image is refused.
+bool decode_stb(const std::uint8_t* data, std::size_t size, std::uint64_t max_texels,
+                std::uint32_t max_side, Texture& out, std::string& why) {
+  if (size > static_cast<std::size_t>(INT32_MAX)) {
+    why = "the image file is larger than 2 GiB";
+    return false;
+  }
+  const int len = static_cast<int>(size);
+  int w = 0, h = 0, channels = 0;
+  if (!stbi_info_from_memory(data, len, &w, &h, &channels)) {
+    why = "not an image format amalgam reads (PNG, JPEG, EXR, TGA, BMP, PSD, GIF, HDR, PIC, PNM)";
+    return false;
+  }
+  if (too_large(static_cast<std::uint64_t>(std::max(w, 0)),
+                static_cast<std::uint64_t>(std::max(h, 0)), max_texels, max_side, why))
+    return false;
+  const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  const stbi_io_callbacks io{&StbSource::read, &StbSource::skip, &StbSource::eof};
+  StbSource source{data, size};
+  std::vector<std::uint8_t> texels(3 * n);
+  bool decoded = false;
+  if (stbi_is_hdr_from_memory(data, len)) {
+    std::unique_ptr<float, void (*)(void*)> rgb(
+        stbi_loadf_from_callbacks(&io, &source, &w, &h, &channels, 3), stbi_image_free);
+    decoded = rgb != nullptr && static_cast<std::size_t>(w) * static_cast<std::size_t>(h) == n;
+    for (std::size_t i = 0; decoded && i < 3 * n; ++i) texels[i] = encode_srgb8(rgb.get()[i]);
+  } else {
+    std::unique_ptr<stbi_uc, void (*)(void*)> rgb(
+        stbi_load_from_callbacks(&io, &source, &w, &h, &channels, 3), stbi_image_free);
+    decoded = rgb != nullptr && static_cast<std::size_t>(w) * static_cast<std::size_t>(h) == n;
+    if (decoded) std::copy(rgb.get(), rgb.get() + 3 * n, texels.begin());
+  }
+  if (!decoded) {
+    const char* reason = stbi_failure_reason();
+    why = std::string("corrupt image data: ") + (reason != nullptr ? reason : "unknown");
+    return false;
+  }
+  if (source.overrun) {
+    why = "the image file ends before its texels do (" + std::to_string(size) + " bytes)";
+    return false;
+  }
+  out.width = static_cast<std::uint32_t>(w), out.height = static_cast<std::uint32_t>(h);
+  out.texels = std::move(texels);
+  return true;
+}
+
 }  // namespace
 
 bool decode_image(const std::uint8_t* data, std::size_t size, std::uint64_t max_texels,
@@ -159,8 +312,10 @@ bool decode_image(const std::uint8_t* data, std::size_t size, std::uint64_t max_
     return decode_png(data, size, max_texels, max_side, out, why);
   if (size >= 3 && data[0] == 0xff && data[1] == 0xd8 && data[2] == 0xff)
     return decode_jpeg(data, size, max_texels, max_side, out, why);
-  why = "not a PNG or JPEG image";
-  return false;
+  static const std::uint8_t kExr[4] = {0x76, 0x2f, 0x31, 0x01};
+  if (size >= 4 && std::memcmp(data, kExr, 4) == 0)
+    return decode_exr(data, size, max_texels, max_side, out, why);
+  return decode_stb(data, size, max_texels, max_side, out, why);
 }
 
 }  // namespace amalgam
