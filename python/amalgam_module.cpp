@@ -346,6 +346,10 @@ std::shared_ptr<Scene> load(const std::string& spec, const py::kwargs& params) {
       config.objects = py::cast<bool>(item.second);
       continue;
     }
+    if (key == "smooth_normals") {  // --smooth-normals
+      config.smooth_normals = py::cast<bool>(item.second);
+      continue;
+    }
     if (!view_keyword(key, item.second, view)) p.set(key, py::str(item.second).cast<std::string>());
   }
   auto s = std::make_shared<Scene>();
@@ -539,7 +543,8 @@ PYBIND11_MODULE(amalgam, m) {
         "or a mesh path. The view keywords camera= (name or index), eye=, look_at=, up=\n"
         "(x, y, z) and fov= (degrees) are the CLI's --camera, --eye, --look-at, --up, --fov.\n"
         "volumetric=True loads it for renderer='volumetric' (every mesh an object with its\n"
-        "volumetric amalgams baked). Raises ValueError with the CLI's message on bad input.");
+        "volumetric amalgams baked); smooth_normals=True is --smooth-normals (meshes without\n"
+        "vertex normals get smooth ones). Raises ValueError with the CLI's message on bad input.");
   m.def("compare", &compare, py::arg("a"), py::arg("b"),
         "compare(a, b) -> dict\n\n"
         "Image metrics of `amalgam compare` for two H x W x 3 images (arrays or RenderResults),\n"

@@ -60,12 +60,15 @@ int main(int argc, char** argv) {
       ++i;
     } else if (a == "--limit-name" && i + 1 < argc) {
       config.limit_name = argv[++i];
+    } else if (a == "--smooth-normals") {
+      config.smooth_normals = true;
     } else if (a == "--" && i + 2 == argc) {
       path = argv[++i];
     } else {
       std::fprintf(stderr,
                    "usage: amalgam-import --parent PID --max-triangles N [--max-bytes B "
-                   "--limit-name TEXT] -- MESH (started by amalgam, which reads its stdout)\n");
+                   "--limit-name TEXT] [--smooth-normals] -- MESH (started by amalgam, which reads "
+                   "its stdout)\n");
       return 2;
     }
   }

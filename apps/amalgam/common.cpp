@@ -61,6 +61,9 @@ void CommonOptions::add_to(CLI::App& app) {
   app.add_option("--eye", eye, "camera position x,y,z (replaces the scene's)");
   app.add_option("--look-at", look_at, "point the camera looks at, x,y,z");
   app.add_option("--up", up, "camera up direction x,y,z");
+  app.add_flag("--smooth-normals", smooth_normals,
+               "give meshes without vertex normals smooth ones (split at creases over 80 "
+               "degrees); meshes with normals are always shaded smooth");
   app.add_option("--fov", fov, "vertical field of view in degrees (0 < DEG < 180)");
   app.add_option("--light-samples", light_samples,
                  "shadow rays per shading point for every sized light (sphere or sun disc; "

@@ -42,6 +42,7 @@ struct CommonOptions {
   CLI::Option* order_option = nullptr;
   std::string camera, eye, look_at, up, fov;  ///< the view options, as given
   int light_samples = 0;                      ///< --light-samples (0: not given)
+  bool smooth_normals = false;                ///< --smooth-normals
   CameraChoice view;                          ///< set by finish()
 
   /// Registers SCENE, --set and the renderer options of docs/cli.md on `app`.

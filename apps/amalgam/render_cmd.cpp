@@ -306,6 +306,7 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
     budget.import_max_bytes = limit;
     budget.import_limit_name = "--max-memory " + format_bytes(static_cast<double>(limit));
     budget.objects = o.renderer() == RendererKind::kVolumetric;
+    budget.smooth_normals = common.smooth_normals;
     budget.on_phase = [&](const std::string& what) {
       set_activity(what);
       status.phase(what);
@@ -519,6 +520,7 @@ int run_trace(CommonOptions& common, const std::string& origin, const std::strin
   set_activity("loading and building " + common.scene);
   SceneFileConfig config;
   config.objects = common.options.renderer() == RendererKind::kVolumetric;
+  config.smooth_normals = common.smooth_normals;
   LoadedScene scene = load_scene(common.scene, common.params(), config);
   common.prepare(scene);
   print_warnings(scene);

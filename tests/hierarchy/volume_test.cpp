@@ -136,3 +136,32 @@ TEST(VolumeCells, CoverageAlongLinesMatchesTheHitProbability) {
 
 }  // namespace
 }  // namespace amalgam
+
+namespace amalgam {
+namespace {
+
+/// The area-weighted mean normal of cell 0 (the root) of `g`, from its normal histogram.
+Vec3 root_mean_normal(const CellGrid& g) {
+  Vec3 sum{};
+  for (int k = 0; k < g.normal_bins(); ++k)
+    sum += g.normal_dirs[static_cast<std::size_t>(k)] *
+           static_cast<float>(g.normals[static_cast<std::size_t>(k)]);
+  return normalize(sum);
+}
+
+// The cells' normal distribution holds the normals the triangles are shaded with: a flat quad
+// whose vertex normals all lean 45 degrees puts its area at the leaning normal.
+TEST(VolumeCells, NormalHistogramsHoldTheInterpolatedNormals) {
+  const std::vector<Primitive> quad = {Primitive::triangle({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, 0),
+                                       Primitive::triangle({0, 0, 0}, {1, 1, 0}, {0, 1, 0}, 0)};
+  VertexNormals lean;
+  for (Vec3& n : lean.n) n = normalize(Vec3{1, 0, 1});
+  const ExplicitHierarchy smooth = build_explicit(quad, {Surface{}}, {}, {}, {}, {lean, lean});
+  const ExplicitHierarchy flat = build_explicit(quad, {Surface{}});
+  const Vec3 s = root_mean_normal(bake_cells(smooth)), f = root_mean_normal(bake_cells(flat));
+  EXPECT_GT(std::fabs(dot(s, lean.n[0])), 0.99f) << s.x << " " << s.y << " " << s.z;
+  EXPECT_GT(std::fabs(f.z), 0.99f) << f.x << " " << f.y << " " << f.z;
+}
+
+}  // namespace
+}  // namespace amalgam

@@ -12,6 +12,7 @@
 #include "amalgam/hierarchy/primitives.h"
 #include "amalgam/hierarchy/wide.h"
 #include "amalgam/scene/texture.h"
+#include "amalgam/scene/vertex_normals.h"
 
 namespace amalgam {
 
@@ -32,6 +33,9 @@ class ExplicitHierarchy {
   /// Texture coordinates per primitive (same order as `prims`) when a material is textured,
   /// else empty: a side table, so untextured scenes pay nothing.
   std::vector<TexCoords> uvs;
+  /// Vertex normals per primitive (same order as `prims`) when the mesh has any, else empty:
+  /// a side table like `uvs`.
+  std::vector<VertexNormals> vertex_normals;
   /// The textures `Surface::texture` indexes (shared by the meshes of an instanced scene).
   std::shared_ptr<const std::vector<Texture>> textures;
   int levels = 0;
@@ -68,6 +72,14 @@ class ExplicitHierarchy {
       m.texture = -1;
     }
     return m;
+  }
+  /// The normal to shade hit `s` on primitive `id` with: its vertex normals interpolated with
+  /// the hit's barycentrics where it has them, else the geometric normal `s.normal`. Either
+  /// way unit length; its side is the caller's to choose.
+  Vec3 shading_normal(PrimId id, const SurfaceHit& s) const {
+    if (vertex_normals.empty()) return s.normal;
+    const Vec3 n = interpolate(vertex_normals[id], s.b1, s.b2);
+    return n == Vec3{} ? s.normal : n;
   }
   /// The colour an amalgam bakes for primitive `id`: its material's colour, times, when
   /// textured, the texture's mean over the triangle's texture coordinates (or over all its

@@ -92,6 +92,18 @@ class InstancedHierarchy {
   Surface surface_at(PrimId p, const SurfaceHit& s) const {
     return meshes[instances[slot(p) - 1].mesh].surface_at(local(p), s);
   }
+  /// As ExplicitHierarchy::shading_normal, in world space: the mesh's interpolated normal
+  /// mapped by the instance's M^-T (world hit `s` carries the object-space barycentrics).
+  Vec3 shading_normal(PrimId p, const SurfaceHit& s) const {
+    const InstanceData& in = instances[slot(p) - 1];
+    const ExplicitHierarchy& mesh = meshes[in.mesh];
+    if (mesh.vertex_normals.empty()) return s.normal;
+    const Vec3 n = interpolate(mesh.vertex_normals[local(p)], s.b1, s.b2);
+    if (n == Vec3{}) return s.normal;
+    if (in.identity) return n;
+    const Vec3 w{dot(in.normal_rows[0], n), dot(in.normal_rows[1], n), dot(in.normal_rows[2], n)};
+    return normalize(w);
+  }
   HierarchyInfo info() const;
   /// The top tree's SIMD form when `build_wide` has built it (and with it every mesh's), else
   /// null: the traversal's generic path.

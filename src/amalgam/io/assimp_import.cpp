@@ -21,6 +21,9 @@ namespace {
 
 /// Assimp's messages can span lines; the contract wants one line, kept whole (one_line).
 constexpr std::size_t kUncut = std::string::npos;
+/// Generated normals (ImportConfig::smooth_normals) are split where faces meet at more than
+/// this angle in degrees, so a cube keeps its edges and a tessellated sphere is smooth.
+constexpr float kSmoothingAngle = 80.0f;
 
 /// Collects Assimp's warnings and errors instead of printing them.
 class CaptureLogger : public Assimp::Logger {
@@ -87,7 +90,12 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
     if (scene != nullptr && !(scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
       assimp_scene::read_cameras_lights(*scene, path, is_gltf(path), out);
       assimp_scene::note_unrendered(*scene, path, out);
-      scene = importer.ApplyPostProcessing(kFlags & ~aiProcess_ValidateDataStructure);
+      // Generated normals only for meshes without (Assimp leaves a mesh's own alone).
+      if (config.smooth_normals)
+        importer.SetPropertyFloat(AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, kSmoothingAngle);
+      scene = importer.ApplyPostProcessing(
+          (kFlags & ~aiProcess_ValidateDataStructure) |
+          (config.smooth_normals ? unsigned{aiProcess_GenSmoothNormals} : 0u));
     }
   } catch (const std::bad_alloc&) {
     throw InputError(out_of_memory_message(path, config));
@@ -127,6 +135,9 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
   const bool textured = std::any_of(out.materials.begin(), out.materials.end(),
                                     [](const Surface& s) { return s.texture >= 0; });
   if (textured) out.uvs.reserve(faces);
+  const bool smooth = std::any_of(scene->mMeshes, scene->mMeshes + scene->mNumMeshes,
+                                  [](const aiMesh* m) { return m != nullptr && m->HasNormals(); });
+  if (smooth) out.normals.reserve(faces);
 
   for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
     const aiMesh* m = scene->mMeshes[mi];
@@ -190,6 +201,17 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
           tc.v[k] = std::isfinite(t.y) ? t.y : 0.0f;
         }
         out.uvs.push_back(tc);
+      }
+      if (smooth) {
+        VertexNormals vn;  // zero (faceted) unless all three are finite
+        for (int k = 0; m->mNormals != nullptr && k < 3; ++k) {
+          const aiVector3D& n = m->mNormals[face.mIndices[k]];
+          vn.n[k] = {n.x, n.y, n.z};
+        }
+        for (const Vec3& n : vn.n)
+          if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z))
+            vn = VertexNormals{};
+        out.normals.push_back(vn);
       }
       out.bounds.extend(p[0]);
       out.bounds.extend(p[1]);

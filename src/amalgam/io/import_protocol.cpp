@@ -13,14 +13,15 @@ static_assert(std::is_trivially_copyable_v<Primitive> && std::is_trivially_copya
 
 /// Names the version and the raw record sizes: a helper built from other sources says so.
 std::string hello() {
-  return "amalgam-import protocol 3: Primitive " + std::to_string(sizeof(Primitive)) +
+  return "amalgam-import protocol 4: Primitive " + std::to_string(sizeof(Primitive)) +
          ", Surface " + std::to_string(sizeof(Surface)) + ", Bbox " + std::to_string(sizeof(Bbox)) +
          ", TexCoords " + std::to_string(sizeof(TexCoords)) + ", Camera " +
-         std::to_string(sizeof(Camera)) + ", Light " + std::to_string(sizeof(Light));
+         std::to_string(sizeof(Camera)) + ", Light " + std::to_string(sizeof(Light)) +
+         ", VertexNormals " + std::to_string(sizeof(VertexNormals));
 }
 
 constexpr std::uint64_t kMaxString = std::uint64_t{1} << 24;
-constexpr int kCounts = 10;
+constexpr int kCounts = 11;
 
 bool send_string(int fd, const std::string& s) {
   const std::uint64_t n = s.size();
@@ -39,14 +40,15 @@ bool read_string(int fd, std::string& s) {
 bool send_mesh(int fd, const ImportedMesh& m) {
   const std::uint8_t status = 0;
   const std::uint64_t counts[kCounts] = {
-      m.triangles.size(), m.materials.size(),    m.dropped_degenerate, m.warnings.size(),
-      m.uvs.size(),       m.textures.size(),     m.cameras.size(),     m.lights.size(),
-      m.dropped.size(),   m.texture_files.size()};
+      m.triangles.size(), m.materials.size(),     m.dropped_degenerate, m.warnings.size(),
+      m.uvs.size(),       m.textures.size(),      m.cameras.size(),     m.lights.size(),
+      m.dropped.size(),   m.texture_files.size(), m.normals.size()};
   if (!send_string(fd, hello()) || !write_all(fd, &status, 1) ||
       !write_all(fd, counts, sizeof counts) ||
       !write_all(fd, m.triangles.data(), m.triangles.size() * sizeof(Primitive)) ||
       !write_all(fd, m.materials.data(), m.materials.size() * sizeof(Surface)) ||
       !write_all(fd, m.uvs.data(), m.uvs.size() * sizeof(TexCoords)) ||
+      !write_all(fd, m.normals.data(), m.normals.size() * sizeof(VertexNormals)) ||
       !write_all(fd, m.lights.data(), m.lights.size() * sizeof(Light)) ||
       !write_all(fd, &m.bounds, sizeof m.bounds))
     return false;
@@ -91,17 +93,19 @@ Reply receive(int fd, std::uint64_t max_triangles) {
       counts[1] > (std::uint64_t{1} << 32) || counts[3] > kMaxString ||
       (counts[4] != 0 && counts[4] != counts[0]) || counts[5] > kMaxTextures ||
       counts[6] > kMaxString || counts[7] > kMaxString || counts[8] > kMaxString ||
-      counts[9] > kMaxTextures)
+      counts[9] > kMaxTextures || (counts[10] != 0 && counts[10] != counts[0]))
     return r;
   ImportedMesh& m = r.mesh;
   m.triangles.resize(counts[0]);
   m.materials.resize(counts[1]);
   m.dropped_degenerate = counts[2];
   m.uvs.resize(counts[4]);
+  m.normals.resize(counts[10]);
   m.lights.resize(counts[7]);
   if (!read_all(fd, m.triangles.data(), counts[0] * sizeof(Primitive)) ||
       !read_all(fd, m.materials.data(), counts[1] * sizeof(Surface)) ||
       !read_all(fd, m.uvs.data(), counts[4] * sizeof(TexCoords)) ||
+      !read_all(fd, m.normals.data(), counts[10] * sizeof(VertexNormals)) ||
       !read_all(fd, m.lights.data(), counts[7] * sizeof(Light)) ||
       !read_all(fd, &m.bounds, sizeof m.bounds))
     return r;

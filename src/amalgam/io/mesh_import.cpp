@@ -73,6 +73,7 @@ class Helper {
     if (config.max_bytes != 0)
       args.insert(args.end(), {"--max-bytes", std::to_string(config.max_bytes), "--limit-name",
                                config.limit_name});
+    if (config.smooth_normals) args.push_back("--smooth-normals");
     args.insert(args.end(), {"--", path});
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());

@@ -19,9 +19,12 @@ namespace amalgam {
 /// material of the file, in the file's coordinates, with the file's base-colour textures,
 /// cameras and lights.
 struct ImportedMesh {
-  std::vector<Primitive> triangles;      ///< all kTriangle; `material` indexes `materials`
-  std::vector<Surface> materials;        ///< never empty; `texture` indexes `textures`
-  std::vector<TexCoords> uvs;            ///< per triangle when a material is textured, or empty
+  std::vector<Primitive> triangles;  ///< all kTriangle; `material` indexes `materials`
+  std::vector<Surface> materials;    ///< never empty; `texture` indexes `textures`
+  std::vector<TexCoords> uvs;        ///< per triangle when a material is textured, or empty
+  /// Per triangle when the file gives vertex normals for any mesh (or they were generated,
+  /// ImportConfig::smooth_normals), else empty; zero for the triangles of meshes without.
+  std::vector<VertexNormals> normals;
   std::vector<Texture> textures;         ///< decoded base-colour images (`mean` set)
   std::vector<NamedCamera> cameras;      ///< glTF perspective cameras, in file order
   std::vector<Light> lights;             ///< point and directional lights
@@ -45,6 +48,9 @@ struct ImportConfig {
   /// applied in a build under AddressSanitizer, whose shadow memory counts against the limit.
   std::uint64_t max_bytes = 0;
   std::string limit_name = "the memory limit";
+  /// Generates smooth vertex normals (Assimp's, angle-weighted, split at creases above 80
+  /// degrees) for the meshes of the file that have none. Off: such meshes render faceted.
+  bool smooth_normals = false;
   /// Seconds the helper may take from its start to the end of its reply, after which it is
   /// killed and the import is an InputError. 0: the environment variable
   /// AMALGAM_IMPORT_TIMEOUT (seconds) if set, else 300 s plus 1 s per MiB of the file.
@@ -60,7 +66,7 @@ struct ImportConfig {
 /// in, points and lines dropped, zero-area triangles dropped. Each material's colour is its
 /// base colour factor (glTF 2 `baseColorFactor`) if present, else its diffuse colour; its
 /// base-colour (or diffuse) texture, from a file beside the mesh or embedded, is decoded in
-/// the helper (PNG or JPEG; one that cannot be read is a line of `dropped`, and the material
+/// the helper (io/image_decode.h; one that cannot be read is a line of `dropped`, and the material
 /// keeps its colour). glTF cameras and Assimp's point and directional lights are returned
 /// (docs/import.md). Throws InputError, one line "<path>: <problem>", when Assimp cannot read the
 /// file, when it reports corrupt data it repaired (faces with out-of-range or missing indices,

@@ -110,9 +110,13 @@ class SceneParser {
           if (placed_.count(m.name) && seen.insert(&m).second)
             instanced += m.mesh->triangles.size();
       std::uint64_t textures = 0;  // texels once per file; coordinates as read and as built
-      for (const auto& [file, mesh] : imported_)
+      bool smooth = false;         // vertex normals: as the coordinates
+      for (const auto& [file, mesh] : imported_) {
         for (const Texture& t : mesh->textures) textures += t.texels.size();
+        smooth = smooth || !mesh->normals.empty();
+      }
       if (textures) textures += 2 * sizeof(TexCoords) * (total + instanced);
+      if (smooth) textures += 2 * sizeof(VertexNormals) * (total + instanced);
       check_memory(r_.file(), MemoryModel::scene(total, instanced, kept) + textures, config_);
     }
     out_.prims.reserve(total);
@@ -194,13 +198,10 @@ class SceneParser {
     std::vector<Primitive> tris(out_.prims.begin() + static_cast<std::ptrdiff_t>(before),
                                 out_.prims.end());
     out_.prims.resize(before);
-    std::vector<TexCoords> uvs;
-    if (out_.uvs.size() > before) {
-      if (!material && !m.mesh->uvs.empty())
-        uvs.assign(out_.uvs.begin() + static_cast<std::ptrdiff_t>(before), out_.uvs.end());
-      out_.uvs.resize(before);
-    }
-    out_.mesh_uvs.push_back(std::move(uvs));
+    out_.mesh_uvs.push_back(
+        scene_json::take_tail(out_.uvs, before, !material && !m.mesh->uvs.empty()));
+    out_.mesh_normals.push_back(
+        scene_json::take_tail(out_.normals, before, !m.mesh->normals.empty()));
     Bbox b;
     for (const Primitive& t : tris) b.extend(amalgam::bounds(t));
     object_bounds_.push_back(b);
@@ -336,6 +337,7 @@ class SceneParser {
           ImportedMesh fine = *e.mesh;
           fine.triangles = subdivide(e.mesh->triangles, levels);
           fine.uvs = subdivide(e.mesh->uvs, levels);
+          fine.normals = subdivide(e.mesh->normals, levels);
           e.mesh = std::make_shared<const ImportedMesh>(std::move(fine));
         }
       }

@@ -42,6 +42,8 @@ struct SceneFileConfig {
   /// `import_limit_name` names it.
   std::uint64_t import_max_bytes = 0;
   std::string import_limit_name = "the memory limit";
+  /// Meshes without vertex normals get smooth ones (ImportConfig::smooth_normals).
+  bool smooth_normals = false;
   /// Called as loading enters each phase ("reading scene.json", "building and baking
   /// scene.json"), e.g. for a status line or an out-of-memory message. Optional.
   std::function<void(const std::string&)> on_phase;

@@ -150,13 +150,22 @@ void append_mesh(SceneDescription& out, const ImportedMesh& mesh, const AffineD&
                  std::optional<std::uint32_t> material, std::uint32_t base) {
   const bool textured = !material && !mesh.uvs.empty();
   if (textured || !out.uvs.empty()) out.uvs.resize(out.prims.size());
+  const bool smooth = !mesh.normals.empty();  // geometry: kept under a replaced material too
+  if (smooth || !out.normals.empty()) out.normals.resize(out.prims.size());
+  Vec3 rows[3];  // M^-T, for the normals
+  const AffineD inv = a.inverse();
+  for (int i = 0; i < 3; ++i)
+    rows[i] = Vec3{static_cast<float>(inv.m[0][i]), static_cast<float>(inv.m[1][i]),
+                   static_cast<float>(inv.m[2][i])};
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
     const Primitive& t = mesh.triangles[i];
     out.prims.push_back(Primitive::triangle(a.point(t.a), a.point(t.b), a.point(t.c),
                                             material ? *material : base + t.material));
     if (textured) out.uvs.push_back(mesh.uvs[i]);
+    if (smooth) out.normals.push_back(transform(mesh.normals[i], rows));
   }
   if (!out.uvs.empty()) out.uvs.resize(out.prims.size());
+  if (!out.normals.empty()) out.normals.resize(out.prims.size());
 }
 
 std::uint32_t append_materials(SceneDescription& out, const ImportedMesh& mesh) {
@@ -207,6 +216,7 @@ ImportConfig import_config(const SceneFileConfig& config) {
   ic.max_triangles = config.max_triangles;
   ic.max_bytes = config.import_max_bytes;
   ic.limit_name = config.import_limit_name;
+  ic.smooth_normals = config.smooth_normals;
   return ic;
 }
 

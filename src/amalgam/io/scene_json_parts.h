@@ -3,13 +3,15 @@
 /// material, the camera, a light, a sphere, box or triangle, a transform. Each checks its
 /// value and throws InputError naming the JSON pointer of what is wrong (JsonReader).
 
+#include <cstddef>
 #include <optional>
+#include <vector>
 
 #include "amalgam/io/json_reader.h"
 #include "amalgam/io/mesh_import.h"
 #include "amalgam/math/transform.h"
-#include "amalgam/scene/instance_patterns.h"
 #include "amalgam/scene/description.h"
+#include "amalgam/scene/instance_patterns.h"
 
 namespace amalgam::scene_json {
 
@@ -46,9 +48,22 @@ AffineD read_matrix(const JsonReader& r, const JsonValue& v);
 /// Appends the triangles of `mesh`, mapped by `a`, to `out.prims`: with `material` for all,
 /// or (none) with the mesh's own materials, which start at `out.materials[base]`. Keeps
 /// `out.uvs` parallel to `out.prims` once any textured material is placed (zeros for
-/// primitives without texture).
+/// primitives without texture), and `out.normals` once any mesh with vertex normals is (mapped
+/// by the inverse transpose of `a`).
 void append_mesh(SceneDescription& out, const ImportedMesh& mesh, const AffineD& a,
                  std::optional<std::uint32_t> material, std::uint32_t base);
+
+/// Cuts the side table `v` (texture coordinates, vertex normals) back to its first `before`
+/// entries and returns the rest when `keep` (else nothing): the entries of the mesh just
+/// appended, taken away for a mesh of its own.
+template <class T>
+std::vector<T> take_tail(std::vector<T>& v, std::size_t before, bool keep) {
+  std::vector<T> tail;
+  if (v.size() <= before) return tail;
+  if (keep) tail.assign(v.begin() + static_cast<std::ptrdiff_t>(before), v.end());
+  v.resize(before);
+  return tail;
+}
 
 /// Appends the materials of `mesh` to `out.materials`, and its textures to `out.textures`
 /// (the materials' texture indices shifted to match). Returns the index of the first.

@@ -19,18 +19,19 @@ AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config) {
     textures = std::make_shared<const std::vector<Texture>>(std::move(d.textures));
   if (d.instances.empty())
     return build_explicit(std::move(d.prims), std::move(d.materials), config, std::move(d.uvs),
-                          std::move(textures));
+                          std::move(textures), std::move(d.normals));
   std::vector<ExplicitHierarchy> meshes;
   meshes.reserve(d.meshes.size() + 1);
   for (std::size_t i = 0; i < d.meshes.size(); ++i)
     meshes.push_back(build_explicit(
         std::move(d.meshes[i]), d.materials, config,
-        i < d.mesh_uvs.size() ? std::move(d.mesh_uvs[i]) : std::vector<TexCoords>{}, textures));
+        i < d.mesh_uvs.size() ? std::move(d.mesh_uvs[i]) : std::vector<TexCoords>{}, textures,
+        i < d.mesh_normals.size() ? std::move(d.mesh_normals[i]) : std::vector<VertexNormals>{}));
   if (!d.prims.empty()) {
     Instance loose;  // identity: traced bit-exactly as in an explicit hierarchy
     loose.mesh = static_cast<std::uint32_t>(meshes.size());
-    meshes.push_back(
-        build_explicit(std::move(d.prims), d.materials, config, std::move(d.uvs), textures));
+    meshes.push_back(build_explicit(std::move(d.prims), d.materials, config, std::move(d.uvs),
+                                    textures, std::move(d.normals)));
     d.instances.push_back(loose);
   }
   return build_instanced(std::move(meshes), std::move(d.instances), config);
@@ -39,17 +40,21 @@ AnyHierarchy build_hierarchy(SceneDescription d, const BuildConfig& config) {
 SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& config) {
   ImportedMesh m = import_mesh(path, import_config(config));
   check_extent(m.bounds, path);
-  std::uint64_t texture_bytes = m.uvs.size() * sizeof(TexCoords) * 2;  // as read, and built
+  std::uint64_t texture_bytes = (m.uvs.size() * sizeof(TexCoords) +  // as read, and built
+                                 m.normals.size() * sizeof(VertexNormals)) *
+                                2;
   for (const Texture& t : m.textures) texture_bytes += t.texels.size();
   check_memory(path, MemoryModel::scene(m.triangles.size(), 0, 0) + texture_bytes, config);
   SceneDescription d;
   if (config.objects) {  // one object, placed once as it is
     d.meshes.push_back(std::move(m.triangles));
     d.mesh_uvs.push_back(std::move(m.uvs));
+    d.mesh_normals.push_back(std::move(m.normals));
     d.instances.push_back(Instance{});
   } else {
     d.prims = std::move(m.triangles);
     d.uvs = std::move(m.uvs);
+    d.normals = std::move(m.normals);
   }
   d.materials = std::move(m.materials);
   d.textures = std::move(m.textures);

@@ -66,8 +66,9 @@ class Integrator {
     Vec3 end = env_.background;
     if (hit.kind == TraceHit::Kind::kPrimitive) {
       const Surface surf = surface_at(h_, hit.id, hit.surf);
-      end = direct(primary, hit.surf, hit.surf.normal, surf, key, shadow_stream);
-      r.normal += facing(hit.surf.normal, wo) * through;
+      const Vec3 n = surface_normal(h_, hit.id, hit.surf, wo);
+      end = direct(primary, hit.surf, n, surf, key, shadow_stream);
+      r.normal += n * through;
       r.albedo += surf.colour * through;
     } else if (hit.kind == TraceHit::Kind::kAmalgam) {
       const Appearance app = h_.appearance(hit.id);
@@ -151,14 +152,16 @@ class Integrator {
       through = 0.0f;
     }
     Surface hit_surface{};
+    Vec3 hit_normal{};
     if (through == 0.0f) {
       // saturated: neither the hit nor the background shows
     } else if (hit.kind == TraceHit::Kind::kPrimitive) {
       hit_surface = surface_at(h_, hit.id, hit.surf);
+      hit_normal = surface_normal(h_, hit.id, hit.surf, wo);
       members_.push_back(
-          {through,
-           direct<false, false>(primary, hit.surf, hit.surf.normal, hit_surface, key, none), -1});
-      r.normal += facing(hit.surf.normal, wo) * through;
+          {through, direct<false, false>(primary, hit.surf, hit_normal, hit_surface, key, none),
+           -1});
+      r.normal += hit_normal * through;
       r.albedo += hit_surface.colour * through;
     } else if (hit.kind == TraceHit::Kind::kAmalgam) {
       const Appearance app = h_.appearance(hit.id);
@@ -185,7 +188,7 @@ class Integrator {
       const TranslucentHit& a = translucent_[static_cast<std::size_t>(m.k)];
       d = shade(primary, a.id, h_.appearance(a.id), a.surf, key, stream);
     } else if (hit.kind == TraceHit::Kind::kPrimitive) {
-      d = direct(primary, hit.surf, hit.surf.normal, hit_surface, key, stream);
+      d = direct(primary, hit.surf, hit_normal, hit_surface, key, stream);
     } else {
       d = shade(primary, hit.id, h_.appearance(hit.id), hit.surf, key, stream);
     }

@@ -65,6 +65,11 @@ struct Hasher {
       add(static_cast<std::uint64_t>(e.textures->size()));
       for (const Texture& t : *e.textures) add(t);
     }
+    if (!e.vertex_normals.empty()) {  // smooth: absent for meshes without vertex normals
+      add(static_cast<std::uint64_t>(e.vertex_normals.size()) | (std::uint64_t{1} << 63));
+      for (const VertexNormals& v : e.vertex_normals)
+        for (const Vec3& n : v.n) add(n);
+    }
   }
 };
 

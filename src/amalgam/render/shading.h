@@ -36,5 +36,22 @@ inline Surface surface_at(const H& h, PrimId id, const SurfaceHit& s) {
   }
 }
 
+/// The normal to shade hit `s` on primitive `id` of `h` with, facing the viewer direction
+/// `wo`: the hierarchy's interpolated vertex normal where it has one (`shading_normal`), else
+/// the geometric normal. A vertex normal is first put on the viewer's side of the geometric
+/// normal; where it still faces away from `wo` (near a silhouette, where interpolation and the
+/// facets disagree) the geometric normal is used.
+template <Hierarchy H>
+inline Vec3 surface_normal(const H& h, PrimId id, const SurfaceHit& s, Vec3 wo) {
+  const Vec3 ng = dot(s.normal, wo) < 0 ? -s.normal : s.normal;
+  if constexpr (requires { h.shading_normal(id, s); }) {
+    Vec3 n = h.shading_normal(id, s);
+    if (dot(n, ng) < 0) n = -n;
+    return dot(n, wo) > 0 ? n : ng;
+  } else {
+    return ng;
+  }
+}
+
 AMALGAM_ISA_END
 }  // namespace amalgam

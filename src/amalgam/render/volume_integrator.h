@@ -89,7 +89,7 @@ class VolumeIntegrator final : private DeferSink {
     const bool end_lit = through > 0.0f && hit.kind == TraceHit::Kind::kPrimitive;
     if (end_lit) {
       end_surface = surface_at(h_, hit.id, hit.surf);
-      r.normal += facing(hit.surf.normal, wo) * through;
+      r.normal += surface_normal(h_, hit.id, hit.surf, wo) * through;
       r.albedo += end_surface.colour * through;
     } else if (through > 0.0f) {
       r.colour += env_.background * through;
@@ -254,8 +254,6 @@ class VolumeIntegrator final : private DeferSink {
     return tr;
   }
 
-  static Vec3 facing(Vec3 n, Vec3 wo) { return dot(n, wo) < 0 ? -n : n; }
-
   /// A direction of world space in the object space of instance `slot`, normalised.
   Vec3 to_object(std::uint64_t slot, Vec3 w) const {
     const IH::InstanceData& in = h_.instances[slot - 1];
@@ -370,7 +368,7 @@ class VolumeIntegrator final : private DeferSink {
       const Vec3 origin = offset_ray_origin(sh.p, sh.p_error, sh.normal);
       LightSample ls;
       if (light_sample(light, origin, samples, u1, u2, ls)) {
-        const Vec3 n = facing(sh.normal, wo);
+        const Vec3 n = surface_normal(h_, hit.id, sh, wo);
         const float f_cos = dot(n, ls.wi);
         if (f_cos > 0.0f && dot(sh.normal, ls.wi) > 0.0f) {
           const Vec3 u = brdf(end_surface, n, ls.wi, wo) * ls.e * f_cos;

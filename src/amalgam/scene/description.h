@@ -6,6 +6,7 @@
 
 #include "amalgam/scene/scene.h"
 #include "amalgam/scene/texture.h"
+#include "amalgam/scene/vertex_normals.h"
 
 namespace amalgam {
 
@@ -22,6 +23,9 @@ struct SceneDescription {
   /// Texture coordinates per primitive of `prims` (same order) when a material has a texture,
   /// else empty; `Surface::texture` indexes `textures`.
   std::vector<TexCoords> uvs;
+  /// Vertex normals per primitive of `prims` (same order) when a mesh placed has them, else
+  /// empty (zero for primitives without).
+  std::vector<VertexNormals> normals;
   std::vector<Texture> textures;
   /// The cameras the file defines (env.camera is the first, or a default view when empty).
   std::vector<NamedCamera> cameras;
@@ -38,7 +42,8 @@ struct SceneDescription {
   /// Empty unless the scene is large enough to keep instances (see SceneFileConfig,
   /// io/scene_json.h).
   std::vector<std::vector<Primitive>> meshes;
-  std::vector<std::vector<TexCoords>> mesh_uvs;  ///< per mesh: as `uvs`, for its primitives
+  std::vector<std::vector<TexCoords>> mesh_uvs;          ///< per mesh: as `uvs`, for its primitives
+  std::vector<std::vector<VertexNormals>> mesh_normals;  ///< per mesh: as `normals`
   std::vector<Instance> instances;
 };
 

@@ -46,4 +46,24 @@ std::vector<TexCoords> subdivide(const std::vector<TexCoords>& uvs, int levels) 
   return out;
 }
 
+std::vector<VertexNormals> subdivide(const std::vector<VertexNormals>& normals, int levels) {
+  std::vector<VertexNormals> out = normals;
+  for (int l = 0; l < levels; ++l) {
+    std::vector<VertexNormals> next;
+    next.reserve(out.size() * 4);
+    for (const VertexNormals& t : out) {
+      Vec3 n[6] = {t.n[0], t.n[1], t.n[2]};  // as for the coordinates above
+      for (int k = 0; k < 3; ++k) n[3 + k] = (t.n[k] + t.n[(k + 1) % 3]) * 0.5f;
+      for (const auto& tri :
+           {std::array{0, 3, 5}, std::array{3, 1, 4}, std::array{5, 4, 2}, std::array{3, 4, 5}}) {
+        VertexNormals c;
+        for (int k = 0; k < 3; ++k) c.n[k] = n[tri[k]];
+        next.push_back(c);
+      }
+    }
+    out = std::move(next);
+  }
+  return out;
+}
+
 }  // namespace amalgam

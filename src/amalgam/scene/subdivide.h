@@ -5,6 +5,7 @@
 
 #include "amalgam/scene/scene.h"
 #include "amalgam/scene/texture.h"
+#include "amalgam/scene/vertex_normals.h"
 
 namespace amalgam {
 
@@ -15,5 +16,10 @@ std::vector<Primitive> subdivide(const std::vector<Primitive>& triangles, int le
 
 /// The texture coordinates of the triangles `subdivide` makes, in the same order.
 std::vector<TexCoords> subdivide(const std::vector<TexCoords>& uvs, int levels);
+
+/// The vertex normals of the triangles `subdivide` makes, in the same order: at a midpoint the
+/// mean of the edge's two normals, unnormalised, so that interpolating across a finer triangle
+/// gives exactly what interpolating across the coarse one gave (the surface stays flat).
+std::vector<VertexNormals> subdivide(const std::vector<VertexNormals>& normals, int levels);
 
 }  // namespace amalgam

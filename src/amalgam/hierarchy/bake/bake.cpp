@@ -262,6 +262,7 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
     bool hit = false, hit_triangle = false;
     Vec3 hit_normal{};  // of a sphere or box hit, facing the line
     std::uint32_t best_prim = 0;
+    TriangleCandidate best{};  // of the closest triangle: its barycentrics for vertex normals
     auto leaf = [&](const ExplicitNode& n, unsigned live) {
       for (std::uint32_t p = n.first; p < n.first + n.count; ++p) {
         if (!((live >> std::min<std::uint32_t>(p - n.first, 31)) & 1u)) continue;
@@ -269,7 +270,7 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
         if (prim.kind == PrimKind::kTriangle) {
           TriangleCandidate c;  // a failed test may leave partial values in it
           if (triangle_test(ray, pre, prim.a, prim.b, prim.c, c)) {
-            hit = hit_triangle = true, best_prim = p;
+            hit = hit_triangle = true, best_prim = p, best = c;
             ray.tmax = c.t;
           }
         } else if (auto s = intersect(prim, ray)) {
@@ -306,7 +307,12 @@ BakeResult bake_exact(const ExplicitHierarchy& h, std::uint32_t id, const BakeCo
       continue;
     }
     const TriangleBake t = cached ? tri[best_prim - top.first] : TriangleBake::of(bp, orientation);
-    normals.add(t.normal, 1.0f);
+    // Smooth triangles bake the normal they are shaded with (interpolated at the hit).
+    const Vec3 smooth =
+        h.vertex_normals.empty()
+            ? Vec3{}
+            : interpolate(h.vertex_normals[best_prim], best.v / best.det, best.w / best.det);
+    normals.add(smooth == Vec3{} ? t.normal : smooth, 1.0f);
     if (orientation == 0)
       oriented = false;
     else if (t.has_outward)

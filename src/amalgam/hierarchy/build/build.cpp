@@ -47,9 +47,12 @@ std::vector<ExplicitNode> explicit_nodes(const SahTree& t) {
 
 ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surface> materials,
                                  const BuildConfig& config, std::vector<TexCoords> uvs,
-                                 std::shared_ptr<const std::vector<Texture>> textures) {
+                                 std::shared_ptr<const std::vector<Texture>> textures,
+                                 std::vector<VertexNormals> normals) {
   AMALGAM_CHECK(uvs.empty() || uvs.size() == prims.size(),
                 "build_explicit: texture coordinates for some primitives only");
+  AMALGAM_CHECK(normals.empty() || normals.size() == prims.size(),
+                "build_explicit: vertex normals for some primitives only");
   ExplicitHierarchy h;
   h.textures = std::move(textures);
   h.materials = std::move(materials);
@@ -65,6 +68,10 @@ ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surfa
   if (!uvs.empty()) {
     h.uvs.resize(uvs.size());
     each(uvs.size(), [&](std::size_t i) { h.uvs[i] = uvs[t.order[i]]; });
+  }
+  if (!normals.empty()) {
+    h.vertex_normals.resize(normals.size());
+    each(normals.size(), [&](std::size_t i) { h.vertex_normals[i] = normals[t.order[i]]; });
   }
   h.nodes = explicit_nodes(t);
   h.levels = t.depth + 2;  // primitives one level below the deepest leaf

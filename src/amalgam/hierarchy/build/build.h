@@ -53,10 +53,12 @@ struct BuildConfig {
 /// Builds a hierarchy over `prims` with a binned SAH, collapsed to `arity`-wide nodes, in
 /// parallel, then bakes every amalgam's appearance bottom-up (bake/bake.h). Empty input gives
 /// a single empty leaf. `uvs`, when not empty, holds the texture coordinates of each of
-/// `prims` (reordered with them); `textures` are those the materials index.
+/// `prims` (reordered with them); `textures` are those the materials index. `normals`, when not
+/// empty, holds the vertex normals of each of `prims` (reordered with them).
 ExplicitHierarchy build_explicit(std::vector<Primitive> prims, std::vector<Surface> materials,
                                  const BuildConfig& config = {}, std::vector<TexCoords> uvs = {},
-                                 std::shared_ptr<const std::vector<Texture>> textures = {});
+                                 std::shared_ptr<const std::vector<Texture>> textures = {},
+                                 std::vector<VertexNormals> normals = {});
 
 /// Builds the top level over `instances` (binned SAH, collapsed to `config.arity`), then
 /// bakes its amalgams from the instance roots. `meshes` must be built and baked already (see

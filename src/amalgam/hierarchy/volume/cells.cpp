@@ -111,7 +111,13 @@ CellGrid bake_cells(const ExplicitHierarchy& mesh, const VolumeConfig& config) {
     const Vec3 cr = cross(b - a, c - a);
     const float len = length(cr);
     if (!(len > 0.0f)) continue;
-    const Vec3 normal = cr / len;
+    // The normal the triangle is shaded with: its vertex normals' at the centroid when it has
+    // them (on the side of its facet), else the facet's.
+    Vec3 normal = cr / len;
+    if (!mesh.vertex_normals.empty()) {
+      const Vec3 smooth = interpolate(mesh.vertex_normals[source[t]], 1.0f / 3, 1.0f / 3);
+      if (smooth != Vec3{}) normal = dot(smooth, normal) < 0 ? -smooth : smooth;
+    }
     const OctahedralLerp nl = OctahedralLerp::of(normal, g.normal_res);
     const Vec3 colour = mesh.bake_colour(source[t]);
     const Surface& m = mesh.materials[mesh.prims.material(source[t])];
