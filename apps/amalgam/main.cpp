@@ -146,7 +146,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "amalgam: " << e.what() << " (see 'amalgam --help')\n";
+    // The help of the command the mistake is in: `amalgam render --help` for a render option.
+    std::string help = "amalgam";
+    for (const CLI::App* sub : app.get_subcommands()) help += " " + sub->get_name();
+    std::cerr << "amalgam: " << e.what() << " (see '" << help << " --help')\n";
     return 2;
   }
 

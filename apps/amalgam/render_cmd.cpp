@@ -458,6 +458,7 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
   run.height = r.height;
   run.spp = r.spp;
   run.threads = render_threads(o);
+  run.ranks = mpi::parallel() ? mpi::size() : 1;
   run.peak_memory_bytes = peak_memory_bytes();
   run.cost_range = range;
   add_run_info(stats, run);

@@ -125,10 +125,11 @@ pid_t rank_pid(pid_t mpirun_pid, int rank) {
 }
 
 /// The counts of a stats JSON: everything but times, memory, the command line and the
-/// thread count.
+/// thread and rank counts.
 nlohmann::json counts(const fs::path& stats) {
   nlohmann::json j = nlohmann::json::parse(slurp(stats));
-  for (const char* k : {"time_s", "peak_memory_bytes", "command_line", "threads"}) j.erase(k);
+  for (const char* k : {"time_s", "peak_memory_bytes", "command_line", "threads", "ranks"})
+    j.erase(k);
   return j;
 }
 
@@ -156,6 +157,8 @@ TEST(CliMpi, ThreeRanksRenderTheBytesOfOneProcess) {
   const nlohmann::json one = counts(p("one.json")), three = counts(p("three.json"));
   EXPECT_EQ(three, one) << three.dump(1) << "\n" << one.dump(1);
   EXPECT_GT(one.at("tests").at("total").get<std::uint64_t>(), 0u);
+  EXPECT_EQ(nlohmann::json::parse(slurp(p("one.json"))).at("ranks"), 1);
+  EXPECT_EQ(nlohmann::json::parse(slurp(p("three.json"))).at("ranks"), 3);
   EXPECT_FALSE(fs::exists(p("three.pfm.ckpt")));
 }
 

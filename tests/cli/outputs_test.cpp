@@ -319,14 +319,32 @@ TEST(RenderOutputs, StatsJsonDescribesTheRunWithIntegersAsIntegers) {
                 .status,
             0);
   const auto j = nlohmann::json::parse(slurp(d / "s.json"));
-  for (const char* key : {"renderer", "opacity", "level", "footprint", "order", "seed", "scene",
-                          "rays", "tests", "per_primary_ray", "time_s", "width", "height", "spp",
-                          "threads", "version", "command_line", "peak_memory_bytes", "cost_range"})
+  for (const char* key : {"renderer",
+                          "opacity",
+                          "level",
+                          "footprint",
+                          "order",
+                          "seed",
+                          "scene",
+                          "rays",
+                          "tests",
+                          "per_primary_ray",
+                          "time_s",
+                          "width",
+                          "height",
+                          "spp",
+                          "threads",
+                          "ranks",
+                          "version",
+                          "command_line",
+                          "peak_memory_bytes",
+                          "cost_range"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["width"], 24);
   EXPECT_EQ(j["height"], 16);
   EXPECT_EQ(j["spp"], 2);
   EXPECT_EQ(j["threads"], 1);
+  EXPECT_EQ(j["ranks"], 1);
   EXPECT_TRUE(j["command_line"].is_array());
   EXPECT_EQ(j["command_line"][1], "render");
   EXPECT_GT(j["peak_memory_bytes"].get<std::uint64_t>(), 1u << 20);

@@ -423,6 +423,13 @@ TEST(Numbers, OutOfRangeIsRefusedWithTheRangeNotClamped) {
     EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
     EXPECT_LT(r.err.size(), 160u) << bad << ": a short line, not CLI11's range dump: " << r.err;
   }
+  // A mistake in a command's option points to that command's help.
+  const CliResult w = amalgam(kSmall + out + " --width 0");
+  EXPECT_NE(w.err.find("(see 'amalgam render --help')"), std::string::npos) << w.err;
+  const CliResult c = amalgam("compare a.png");
+  EXPECT_NE(c.err.find("(see 'amalgam compare --help')"), std::string::npos) << c.err;
+  const CliResult none = amalgam("--no-such-option");
+  EXPECT_NE(none.err.find("(see 'amalgam --help')"), std::string::npos) << none.err;
 }
 
 // Values refused where they are checked elsewhere were accepted here: NaN seconds (CLI11's

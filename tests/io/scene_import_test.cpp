@@ -13,6 +13,7 @@
 #include <iterator>
 #include <numbers>
 #include <string>
+#include <variant>
 
 #include "amalgam/hierarchy/build/build.h"
 #include "amalgam/io/mesh_import.h"
@@ -462,6 +463,34 @@ TEST(GltfCamera, DefaultLightsFollowAChosenView) {
   choose_camera(s, {"", Vec3{0, 0, 4}, Vec3{0, 0, 0}, {}, {}});
   ASSERT_EQ(s.env.lights.size(), 2u);
   EXPECT_EQ(s.env.lights[1].position, (Vec3{0, 0, 4}));  // the fill light at the eye
+}
+
+// A mesh without a camera (an STL, whose up axis is z) framed by --up alone: the same 3/4 view
+// about z (camera above along z, in front on the -y side), lights turned with it; with +y, the
+// default view exactly.
+TEST(DefaultView, UpAloneFramesTheMeshAboutThatUp) {
+  REQUIRE_GLTF_MODELS();
+  LoadedScene s = load_scene_path("/usr/share/assimp/models/STL/Spider_binary.stl");
+  ASSERT_TRUE(s.framed_camera);
+  const Camera y_up = s.env.camera;
+  const Vec3 key_y = s.env.lights[0].direction;
+  const Bbox b = std::visit([](const auto& h) { return h.bounds(h.root()); }, s.hierarchy);
+  const Vec3 centre = b.center();
+  EXPECT_GT(y_up.position.y, centre.y);
+  choose_camera(s, {"", {}, {}, Vec3{0, 1, 0}, {}});
+  EXPECT_EQ(s.env.camera.position, y_up.position);
+  EXPECT_EQ(s.env.lights[0].direction, key_y);
+  choose_camera(s, {"", {}, {}, Vec3{0, 0, 2}, {}});
+  const Camera& z_up = s.env.camera;
+  EXPECT_EQ(z_up.up, (Vec3{0, 0, 2}));
+  EXPECT_EQ(z_up.look_at, centre);
+  EXPECT_GT(z_up.position.z - centre.z, 0.3f * length(z_up.position - centre));  // above
+  EXPECT_LT(z_up.position.y, centre.y);                                          // in front
+  EXPECT_NEAR(length(z_up.position - centre), length(y_up.position - centre), 1e-3f);
+  EXPECT_LT(s.env.lights[0].direction.z, -0.5f);  // the key light shines down along z
+  // With --eye, --up only sets the camera's up, as for any camera.
+  choose_camera(s, {"", Vec3{0, -30, 5}, {}, Vec3{0, 0, 1}, {}});
+  EXPECT_EQ(s.env.camera.position, (Vec3{0, -30, 5}));
 }
 
 /// One triangle with three KHR_lights_punctual lights: a point light, a directional light

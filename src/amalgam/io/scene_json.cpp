@@ -170,7 +170,7 @@ class SceneParser {
     if (auto c = r_.find(root, "camera"))
       out_.env.camera = scene_json::read_camera(r_, *c);
     else
-      out_.env.camera = frame_camera(bounds);
+      out_.env.camera = frame_camera(bounds), out_.framed_camera = true;
     if (auto l = r_.find(root, "lights"))
       read_lights(*l);
     else

@@ -106,6 +106,7 @@ void add_run_info(nlohmann::json& j, const RunInfo& info) {
   j["height"] = info.height;
   j["spp"] = info.spp;
   j["threads"] = info.threads;
+  j["ranks"] = info.ranks;
   j["command_line"] = info.argv;
   j["peak_memory_bytes"] = info.peak_memory_bytes;
   if (info.cost_range)

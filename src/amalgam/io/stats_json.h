@@ -37,14 +37,15 @@ struct RunInfo {
   std::vector<std::string> argv;  ///< the command line, as given
   int width = 0, height = 0;
   int spp = 0;      ///< samples per pixel the outputs hold
-  int threads = 0;  ///< worker threads used
+  int threads = 0;  ///< worker threads used (per rank under MPI)
+  int ranks = 1;    ///< MPI ranks that rendered the image (1 without mpirun)
   std::uint64_t peak_memory_bytes = 0;
   /// The cost PNG's scale (--cost-range, else the image's own range), also when no PNG is
   /// written: the range to give another render's --cost-range to compare the two.
   std::optional<LogRange> cost_range;
 };
 
-/// Adds "width", "height", "spp", "threads", "command_line", "peak_memory_bytes" and
+/// Adds "width", "height", "spp", "threads", "ranks", "command_line", "peak_memory_bytes" and
 /// "cost_range" ({"min", "max", "scale": "log", "unit"}) to `j`.
 void add_run_info(nlohmann::json& j, const RunInfo& info);
 

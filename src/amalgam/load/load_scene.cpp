@@ -62,6 +62,7 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
   d.warnings = std::move(m.dropped);
   d.inputs = std::move(m.texture_files);
   d.env.camera = d.cameras.empty() ? frame_camera(m.bounds) : d.cameras.front().camera;
+  d.framed_camera = d.cameras.empty();
   d.default_lights = m.lights.empty();
   d.env.lights = d.default_lights ? default_lights(m.bounds, d.env.camera) : std::move(m.lights);
   return d;
@@ -81,7 +82,7 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   std::vector<std::string> warnings = std::move(d.warnings);
   std::vector<std::string> inputs = {path};
   inputs.insert(inputs.end(), d.inputs.begin(), d.inputs.end());
-  const bool defaults = d.default_lights;
+  const bool defaults = d.default_lights, framed = d.framed_camera;
   if (config.on_phase) config.on_phase("building and baking " + path);
   double bake_seconds = 0.0;
   BuildConfig build;
@@ -101,11 +102,20 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   s.warnings = std::move(warnings);
   s.inputs = std::move(inputs);
   s.default_lights = defaults;
+  s.framed_camera = framed;
   s.load_seconds = std::chrono::duration<double>(t1 - t0).count();
   s.bake_seconds = bake_seconds;
   s.build_seconds = std::max(0.0, std::chrono::duration<double>(t2 - t1).count() - bake_seconds);
   return s;
 }
+
+namespace {
+
+Bbox scene_bounds(const LoadedScene& scene) {
+  return std::visit([](const auto& h) { return h.bounds(h.root()); }, scene.hierarchy);
+}
+
+}  // namespace
 
 Environment chosen_view(const LoadedScene& scene, const CameraChoice& choice) {
   Camera c = scene.env.camera;
@@ -139,6 +149,11 @@ Environment chosen_view(const LoadedScene& scene, const CameraChoice& choice) {
                        ": expected a vertical field of view in degrees, > 0 and < 180");
     c.vfov_deg = *choice.fov_deg;
   }
+  // A default view given only an up direction: the same 3/4 view about that up (a file whose
+  // up axis is z, such as an STL, is framed upright by --up 0,0,1, not rolled on its side).
+  if (scene.framed_camera && choice.camera.empty() && choice.up && !choice.eye && !choice.look_at &&
+      length(*choice.up) > 0.0f)
+    c = frame_camera(scene_bounds(scene), c.vfov_deg, *choice.up);
   const Vec3 dir = c.look_at - c.position;
   if (!(length(dir) > 0.0f))
     throw InputError("--eye/--look-at: the eye is at the look-at point (no view direction)");
@@ -157,10 +172,8 @@ Environment chosen_view(const LoadedScene& scene, const CameraChoice& choice) {
   }
   if (!changed) return env;
   env.camera = c;
-  if (scene.default_lights) {  // (unsized: light_samples does not apply to them)
-    const Bbox b = std::visit([](const auto& h) { return h.bounds(h.root()); }, scene.hierarchy);
-    env.lights = default_lights(b, c);
-  }
+  if (scene.default_lights)  // (unsized: light_samples does not apply to them)
+    env.lights = default_lights(scene_bounds(scene), c);
   return env;
 }
 

@@ -38,6 +38,8 @@ struct LoadedScene {
   std::vector<NamedCamera> cameras{};
   /// env.lights are the default lights for env.camera (they follow a camera chosen later).
   bool default_lights = false;
+  /// env.camera frames the scene by default (SceneDescription::framed_camera).
+  bool framed_camera = false;
   /// What the scene file holds that is not rendered, one line each (the CLI prints them).
   std::vector<std::string> warnings{};
   /// The files read (the scene file, its meshes and their textures; none for a builtin): what

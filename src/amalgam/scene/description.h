@@ -32,6 +32,9 @@ struct SceneDescription {
   /// True when env.lights are default_lights (scene/framing.h) for env.camera: a camera chosen
   /// later moves them with it.
   bool default_lights = false;
+  /// True when env.camera is frame_camera's (the file gives no camera): `--up` alone frames
+  /// the scene again about that up direction.
+  bool framed_camera = false;
   /// What the file holds that is not rendered, one line each, for the user to see.
   std::vector<std::string> warnings;
   /// The files read besides the scene file itself (meshes, their textures): inputs that an
