@@ -1,6 +1,6 @@
 """Type stub of the amalgam module (python/amalgam_module.cpp; docs/python.md)."""
 
-from typing import Any, Optional, Sequence, Union
+from typing import Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -25,6 +25,8 @@ class RenderResult:
     spp_requested: int
     interrupted: bool
     seconds: float
+    def save(self, path: str) -> None:
+        """Writes the image as `render --out` does: .png (8-bit sRGB), .exr or .pfm."""
 
 class Scene:
     """A loaded scene: its built, baked hierarchy, reused by every render."""
@@ -58,6 +60,7 @@ class Scene:
         fov: Optional[float] = None,
         light_samples: Optional[int] = None,
         tracer: str = "amalgam",  # or "embree": full detail in Intel Embree 3
+        progress: Optional[Callable[[int, int], None]] = None,  # f(spp_done, spp)
     ) -> RenderResult:
         """Renders the camera view (camera=, eye=, look_at=, up=, fov= change it for this
         render only, from the view `load` chose); KeyboardInterrupt carries `.partial`."""
@@ -86,10 +89,18 @@ def load(
     look_at: Sequence[float] = ...,
     up: Sequence[float] = ...,
     fov: float = ...,
+    volumetric: bool = ...,  # --renderer volumetric: objects with their cells baked
+    smooth_normals: bool = ...,  # --smooth-normals
     **params: Union[int, float, str],
 ) -> Scene:
     """'builtin:NAME' with parameters as keywords, a scene .json, or a mesh path; the view
     keywords are the CLI's --camera, --eye, --look-at, --up, --fov."""
+
+def save_image(path: str, image: Union[RenderResult, npt.ArrayLike]) -> None:
+    """Writes H x W x 3 linear RGB as `render --out` does, by extension: .png, .exr, .pfm."""
+
+def to_srgb(image: Union[RenderResult, npt.ArrayLike]) -> npt.NDArray[np.uint8]:
+    """Linear RGB as the 8-bit sRGB a PNG output stores (clamped, sRGB curve, rounded)."""
 
 def compare(
     a: Union[RenderResult, npt.ArrayLike], b: Union[RenderResult, npt.ArrayLike]

@@ -22,6 +22,8 @@
 #include "amalgam/analysis/experiments.h"
 #include "amalgam/analysis/metrics.h"
 #include "amalgam/io/colormap.h"
+#include "amalgam/io/image.h"
+#include "amalgam/io/srgb.h"
 #include "amalgam/io/stats_json.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/option_rules.h"
@@ -244,9 +246,11 @@ struct Scene {
       const std::string& order, Strict<std::uint64_t> seed, Strict<int> threads,
       const std::string& sampler, const py::object& camera, const py::object& eye,
       const py::object& look_at, const py::object& up, const py::object& fov,
-      const py::object& light_samples, const std::string& tracer_name) {
+      const py::object& light_samples, const std::string& tracer_name, const py::object& progress) {
     const Options opt = make_options(width, height, spp, renderer, opacity, level, footprint, order,
                                      seed, threads, sampler, tracer_name);
+    if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
+      throw InputError("progress=: expected a callable progress(spp_done, spp), or None");
     check_options(*scene, opt.o, OptionSpelling::kKeywords);
     std::shared_ptr<const Tracer> tracer = tracer_for(opt.o);
     // Another view of the same built, baked scene: only the environment is new.
@@ -260,16 +264,32 @@ struct Scene {
     // The render runs on its own thread while this one, without the GIL, waits for it and
     // every 50 ms takes the GIL to run Python's signal handlers (PyErr_CheckSignals): a
     // KeyboardInterrupt cancels the render at its next tile (RenderControl::cancel).
+    // progress(spp_done, spp) is called from this thread too, with the GIL, when a pass of
+    // samples has completed since the last call, and once at the end.
     auto cancel = std::make_shared<std::atomic<bool>>(false);
+    auto passes = std::make_shared<std::atomic<int>>(0);
     std::shared_ptr<const LoadedScene> keep = scene;
     const RenderOptions o = opt.o;
-    std::packaged_task<RenderOutput()> task([keep, tracer, env, o, cancel] {
+    std::packaged_task<RenderOutput()> task([keep, tracer, env, o, cancel, passes] {
       RenderControl control;
       control.cancel = cancel.get();
+      control.on_pass = [passes](const FilmState& st) { passes->store(st.spp_done); };
       return tracer->render_view(*env, o, nullptr, control);
     });
-    std::future<RenderOutput> done = task.get_future();
     std::optional<py::error_already_set> interrupt;
+    int reported = 0;
+    auto report = [&] {  // with the GIL
+      const int done_spp = passes->load();
+      if (progress.is_none() || interrupt || done_spp == reported) return;
+      reported = done_spp;
+      try {
+        progress(done_spp, o.spp);
+      } catch (py::error_already_set& e) {  // the callback's exception stops the render
+        interrupt.emplace(std::move(e));
+        cancel->store(true);
+      }
+    };
+    std::future<RenderOutput> done = task.get_future();
     {
       py::gil_scoped_release nogil;
       std::thread worker(std::move(task));
@@ -279,10 +299,13 @@ struct Scene {
         if (PyErr_CheckSignals() != 0) {
           interrupt.emplace();  // fetches the exception the handler raised
           cancel->store(true);
+          continue;
         }
+        report();
       }
       worker.join();
     }
+    report();
     RenderOutput out = done.get();  // rethrows a failure of the render
     auto result = make_result(*scene, o, std::move(out), tracer->build_seconds());
     {
@@ -376,6 +399,29 @@ std::vector<Vec3> pixels(const py::object& x, const char* name, int& w, int& h) 
   const float* d = arr.data();
   for (std::size_t i = 0; i < v.size(); ++i) v[i] = {d[3 * i], d[3 * i + 1], d[3 * i + 2]};
   return v;
+}
+
+/// `amalgam.save_image`: an image through the CLI's writers (render --out), by extension.
+void save_image(const std::string& path, const py::object& image) {
+  int w = 0, h = 0;
+  const std::vector<Vec3> px = pixels(image, "image", w, h);
+  if (w == 0 || h == 0) throw InputError("image: the image is empty");
+  if (!is_image_path(path))
+    throw InputError(one_line(path, 200) + ": expected a .png, .exr or .pfm path");
+  py::gil_scoped_release nogil;
+  write_image(path, w, h, px);
+}
+
+/// `amalgam.to_srgb`: linear RGB as the 8-bit sRGB a PNG stores (the same rounding).
+py::array_t<std::uint8_t> to_srgb(const py::object& image) {
+  int w = 0, h = 0;
+  const std::vector<Vec3> px = pixels(image, "image", w, h);
+  py::array_t<std::uint8_t> out(
+      {static_cast<py::ssize_t>(h), static_cast<py::ssize_t>(w), py::ssize_t{3}});
+  std::uint8_t* d = out.mutable_data();
+  for (std::size_t i = 0; i < px.size(); ++i)
+    for (int k = 0; k < 3; ++k) d[3 * i + static_cast<std::size_t>(k)] = encode_srgb8(px[i][k]);
+  return out;
 }
 
 py::dict compare(const py::object& a, const py::object& b) {
@@ -485,6 +531,9 @@ PYBIND11_MODULE(amalgam, m) {
       .def_readonly("interrupted", &RenderResult::interrupted,
                     "True when a KeyboardInterrupt stopped the render before spp_requested")
       .def_readonly("seconds", &RenderResult::seconds, "render time")
+      .def(
+          "save", [](const py::object& self, const std::string& path) { save_image(path, self); },
+          py::arg("path"), "Writes the image as amalgam.save_image(path, self) does.")
       .def("__repr__", [](const RenderResult& r) {
         return "<amalgam.RenderResult " + std::to_string(r.width) + "x" + std::to_string(r.height) +
                ", " + std::to_string(r.spp) + " spp" + (r.interrupted ? ", interrupted" : "") + ">";
@@ -500,6 +549,7 @@ PYBIND11_MODULE(amalgam, m) {
            py::arg("camera") = py::none(), py::arg("eye") = py::none(),
            py::arg("look_at") = py::none(), py::arg("up") = py::none(), py::arg("fov") = py::none(),
            py::arg("light_samples") = py::none(), py::arg("tracer") = "amalgam",
+           py::arg("progress") = py::none(),
            "Renders the scene's camera view; the options are the CLI's (docs/cli.md). camera=\n"
            "(name or index), eye=, look_at=, up= (x, y, z) and fov= (degrees) change the view\n"
            "of this render only, as --camera, --eye, --look-at, --up and --fov do, starting from\n"
@@ -510,7 +560,9 @@ PYBIND11_MODULE(amalgam, m) {
            "seed gives the same image as `amalgam render ... --out x.pfm`, bit for bit, on any\n"
            "number of threads. The GIL is released. Ctrl-C (KeyboardInterrupt) stops the render\n"
            "at its next tile; the exception's `partial` attribute (and scene.last_result) holds\n"
-           "the completed samples. Raises ValueError on bad options (e.g. level beyond l_max).")
+           "the completed samples. progress=f calls f(spp_done, spp) on this thread as passes\n"
+           "of samples complete (and once at the end); an exception it raises stops the render\n"
+           "as Ctrl-C does. Raises ValueError on bad options (e.g. level beyond l_max).")
       .def("trace", &Scene::trace, py::arg("origin") = py::none(),
            py::arg("direction") = py::none(), py::kw_only(), py::arg("width") = 512,
            py::arg("height") = 512, py::arg("renderer") = "scale-sensitive",
@@ -545,6 +597,15 @@ PYBIND11_MODULE(amalgam, m) {
         "volumetric=True loads it for renderer='volumetric' (every mesh an object with its\n"
         "volumetric amalgams baked); smooth_normals=True is --smooth-normals (meshes without\n"
         "vertex normals get smooth ones). Raises ValueError with the CLI's message on bad input.");
+  m.def("save_image", &save_image, py::arg("path"), py::arg("image"),
+        "save_image(path, image)\n\n"
+        "Writes an H x W x 3 linear RGB image (an array or a RenderResult) as `render --out`\n"
+        "does, by the extension of `path`: .png (8-bit sRGB), .exr (float32), .pfm (float32).\n"
+        "Raises ValueError on a bad image or extension, RuntimeError when writing fails.");
+  m.def("to_srgb", &to_srgb, py::arg("image"),
+        "to_srgb(image) -> uint8 H x W x 3\n\n"
+        "Linear RGB (an array or a RenderResult) encoded as the PNG output stores it: clamped\n"
+        "to [0, 1], the sRGB transfer function (IEC 61966-2-1), rounded to 8 bits.");
   m.def("compare", &compare, py::arg("a"), py::arg("b"),
         "compare(a, b) -> dict\n\n"
         "Image metrics of `amalgam compare` for two H x W x 3 images (arrays or RenderResults),\n"

@@ -273,3 +273,53 @@ def test_embree_same_bits_as_cli(cli, tmp_path):
     assert hit["object"]["id"] == ours["object"]["id"] and hit["t"] == ours["t"]
     with pytest.raises(ValueError, match="^tracer=embree renders at full detail: level="):
         s.render(width=8, height=8, tracer="embree", level=1)
+
+
+def test_save_writes_what_the_cli_writes(cli, demo, tmp_path):
+    subprocess.run(
+        [cli, "render", "builtin:demo", "--width", "40", "--height", "30", "--spp", "2",
+         "--seed", "7", "--out", str(tmp_path / "cli.pfm")], check=True, capture_output=True)
+    r = demo.render(width=40, height=30, spp=2, seed=7)
+    r.save(str(tmp_path / "x.pfm"))
+    assert (tmp_path / "x.pfm").read_bytes() == (tmp_path / "cli.pfm").read_bytes()
+    amalgam.save_image(str(tmp_path / "y.pfm"), r.image)
+    assert (tmp_path / "y.pfm").read_bytes() == (tmp_path / "cli.pfm").read_bytes()
+    # PNG: the 8-bit sRGB that to_srgb computes; EXR: float32, read back by the CLI's compare.
+    r.save(str(tmp_path / "x.png"))
+    import matplotlib.image
+    png = np.rint(matplotlib.image.imread(str(tmp_path / "x.png"))[:, :, :3] * 255)
+    srgb = amalgam.to_srgb(r)
+    assert srgb.dtype == np.uint8 and srgb.shape == (30, 40, 3)
+    assert np.array_equal(png.astype(np.uint8), srgb)
+    r.save(str(tmp_path / "x.exr"))
+    out = subprocess.run([cli, "compare", str(tmp_path / "x.exr"), str(tmp_path / "cli.pfm"),
+                          "--json"], check=True, capture_output=True, text=True).stdout
+    assert json.loads(out)["max_abs_error"] == 0
+    with pytest.raises(ValueError, match="expected a .png, .exr or .pfm path"):
+        r.save(str(tmp_path / "x.jpg"))
+    with pytest.raises(ValueError, match="^image: expected an H x W x 3 image"):
+        amalgam.save_image(str(tmp_path / "z.png"), np.zeros((4, 4)))
+
+
+def test_to_srgb_is_the_srgb_curve():
+    linear = np.array([[[0.0, 0.0031308, 0.5], [1.0, 2.0, -1.0]]], dtype=np.float32)
+    srgb = amalgam.to_srgb(linear)
+    assert srgb.tolist() == [[[0, 10, 188], [255, 255, 0]]]
+
+
+def test_progress_callback(demo):
+    seen = []
+    demo.render(width=256, height=256, spp=4, seed=1,
+                progress=lambda done, total: seen.append((done, total)))
+    assert seen and seen[-1] == (4, 4)
+    done = [d for d, _ in seen]
+    assert done == sorted(set(done)) and all(t == 4 for _, t in seen)
+
+    def stop(done, total):
+        raise RuntimeError("enough")
+
+    with pytest.raises(RuntimeError, match="enough") as e:
+        demo.render(width=256, height=256, spp=5000, seed=1, progress=stop)
+    assert e.value.partial.interrupted and e.value.partial.spp < 5000
+    with pytest.raises(ValueError, match="^progress=: expected a callable"):
+        demo.render(width=8, height=8, progress=3)
