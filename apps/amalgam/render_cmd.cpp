@@ -264,8 +264,10 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
 #if defined(AMALGAM_HAVE_MPI)
   const bool parallel = mpi::parallel();  // one of several ranks under mpirun (docs/mpi.md)
   const bool root = !parallel || mpi::rank() == 0;
+  const int ranks = parallel ? mpi::size() : 1;
 #else
   const bool parallel = false, root = true;
+  const int ranks = 1;
 #endif
   if (!root) extra.quiet = true;  // rank 0 speaks for the job
   const RenderOptions& o = common.options;
@@ -458,7 +460,7 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
   run.height = r.height;
   run.spp = r.spp;
   run.threads = render_threads(o);
-  run.ranks = mpi::parallel() ? mpi::size() : 1;
+  run.ranks = ranks;
   run.peak_memory_bytes = peak_memory_bytes();
   run.cost_range = range;
   add_run_info(stats, run);
