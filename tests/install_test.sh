@@ -10,7 +10,8 @@ build=$1 src=$2 cxx_flags=${3:-} link_flags=${4:-}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cmake --install "$build" --prefix "$tmp/prefix" >/dev/null
-for f in bin/amalgam bin/amalgam-import include/amalgam/render/render.h \
+for f in bin/amalgam bin/amalgam-import share/amalgam/scenes/field.json \
+         include/amalgam/render/render.h \
          include/amalgam/render/render_isa.inl lib/cmake/amalgam/amalgamConfig.cmake; do
   [ -e "$tmp/prefix/$f" ] || { echo "not installed: $f"; exit 1; }
 done

@@ -101,7 +101,10 @@ struct RenderExtras {
 int run_render(CommonOptions& common, const RenderExtras& extra);
 int run_trace(CommonOptions& common, const std::string& origin, const std::string& direction);
 int run_scenes();
-int run_experiment(const std::string& name, const std::string& out_dir, bool quick, int threads);
+/// `amalgam experiment`: scene files named scenes/... are read from `scenes_dir` (else found as
+/// bundled_scenes_dir says); a part not measured is a warning and exit 1 unless `allow_partial`.
+int run_experiment(const std::string& name, const std::string& out_dir, bool quick, int threads,
+                   const std::string& scenes_dir, bool allow_partial);
 
 /// The arguments of `compare`.
 struct CompareOptions {

@@ -115,6 +115,8 @@ int main(int argc, char** argv) {
   std::string exp_name, exp_out;
   bool exp_quick = false;
   int exp_threads = 0;
+  std::string exp_scenes;
+  bool exp_partial = false;
   CLI::App* experiment = app.add_subcommand(
       "experiment", "reproduce the paper's analyses as measured sweeps (NAME or all)");
   std::string exp_names;
@@ -124,6 +126,12 @@ int main(int argc, char** argv) {
       ->required();
   experiment->add_option("--out", exp_out, "output directory")->required();
   experiment->add_flag("--quick", exp_quick, "small sizes (as the tests use)");
+  experiment->add_option("--scenes", exp_scenes,
+                         "the bundled scene files (scenes/field.json, ...) in DIR (default: "
+                         "installed with amalgam, or the source tree it was built from)");
+  experiment->add_flag("--allow-partial", exp_partial,
+                       "exit 0 with a partial report when a part cannot be measured (a scene "
+                       "file missing); otherwise that is exit 1");
   experiment->add_option("--threads", exp_threads, "worker threads (default: all cores)")
       ->check(cli::non_negative_int());
 
@@ -157,7 +165,9 @@ int main(int argc, char** argv) {
   try {
     if (render->parsed()) return cli::run_render(render_opts, extras);
     if (trace->parsed()) return cli::run_trace(trace_opts, origin, direction);
-    if (experiment->parsed()) return cli::run_experiment(exp_name, exp_out, exp_quick, exp_threads);
+    if (experiment->parsed())
+      return cli::run_experiment(exp_name, exp_out, exp_quick, exp_threads, exp_scenes,
+                                 exp_partial);
     if (compare->parsed()) return cli::run_compare(cmp);
     return cli::run_scenes();
   } catch (const std::bad_alloc&) {

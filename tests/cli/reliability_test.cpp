@@ -627,5 +627,32 @@ TEST(MaxMemory, EstimatedBeforeBuildingWithin25PercentOfThePeak) {
 }
 #endif
 
+// `amalgam experiment` outside the repository finds the bundled scene files (installed, or the
+// source tree it was built from); a part that cannot be measured is a warning on stderr and
+// exit 1, unless --allow-partial, and never a silent "holds".
+TEST(Experiment, RunsFromAnyDirectoryAndNeverSkipsAPartSilently) {
+  const Dir dir("exp-cwd");
+  const fs::path d = dir.path;
+  fs::create_directories(d / "empty");
+  const std::string run = "experiment premise --quick --threads 1 --out ";
+  const CliResult ok = amalgam(run + "r1", d.string());
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  const std::string report = slurp((d / "r1/report.md").string());
+  EXPECT_NE(report.find("the field"), std::string::npos);
+  EXPECT_EQ(report.find(": not measured:"), std::string::npos) << report;
+  const CliResult part = amalgam(run + "r2 --scenes empty", d.string());
+  EXPECT_EQ(part.status, 1) << part.err;
+  EXPECT_NE(part.err.find("warning: experiment premise: the field"), std::string::npos) << part.err;
+  EXPECT_NE(part.err.find("the report is partial"), std::string::npos) << part.err;
+  EXPECT_NE(slurp((d / "r2/report.md").string()).find("the field: not measured:"),
+            std::string::npos);
+  const CliResult allowed = amalgam(run + "r3 --scenes empty --allow-partial", d.string());
+  EXPECT_EQ(allowed.status, 0) << allowed.err;
+  EXPECT_NE(allowed.err.find("(not measured)"), std::string::npos) << allowed.err;
+  const CliResult bad = amalgam(run + "r4 --scenes no-such-dir", d.string());
+  EXPECT_EQ(bad.status, 2) << bad.err;
+  EXPECT_NE(bad.err.find("--scenes no-such-dir: not a directory"), std::string::npos) << bad.err;
+}
+
 }  // namespace reliability
 }  // namespace

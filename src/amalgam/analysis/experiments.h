@@ -129,6 +129,9 @@ struct ExperimentResult {
   std::vector<Check> checks;
   Verdict verdict = Verdict::kHolds;  ///< set by run() from `checks` (verdict_of)
   std::string findings;  ///< measured key figures and the reasoning for the verdict (markdown)
+  /// Parts that could not be measured (a scene file that would not load), one line each: the
+  /// report is then partial, which the CLI says and refuses unless --allow-partial.
+  std::vector<std::string> not_measured;
   double seconds = 0;
 };
 

@@ -79,6 +79,7 @@ ExperimentResult noise_baked(const Config& c) {
       loaded.emplace(c.load(sp.path));
     } catch (const std::exception& e) {
       unavailable += "* " + sp.label + " (`" + sp.path + "`): not measured: " + e.what() + "\n";
+      r.not_measured.push_back(sp.label + ": " + e.what());
       continue;
     }
     const LoadedScene& s = *loaded;

@@ -100,6 +100,7 @@ ExperimentResult premise(const Config& c) {
         throw std::runtime_error("no scene loader given (Config::load)");
     } catch (const std::exception& e) {
       unavailable += "* " + sp.label + ": not measured: " + e.what() + "\n";
+      r.not_measured.push_back(sp.label + ": " + e.what());
       continue;
     }
     double trad_seconds = 0, trad_tests = 0;
