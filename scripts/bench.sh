@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # Benchmarks: builds Release and runs the kernel benchmarks, amalgam vs Embree side by side.
 #
-#   scripts/bench.sh            full run (about 3 minutes on 2 cores): bench/results/ (Google
-#                               Benchmark JSON, the field's results.json and images), the tables
-#                               in docs/benchmarks.md and the README's speed section (between
-#                               its bench markers), every ratio from this one run
+#   scripts/bench.sh            full run (about 3 minutes on 2 cores) into out/bench/: results/
+#                               (Google Benchmark JSON, the field's results.json and images),
+#                               benchmarks.md and README.md (copies of the docs page and the
+#                               README with their generated tables rewritten); touches no docs
+#   scripts/bench.sh --update-docs   the same into bench/results/, the tables in
+#                               docs/benchmarks.md and the README's speed section (between its
+#                               bench markers), every ratio from this one run
 #   scripts/bench.sh --quick    smoke run (smallest scenes, minimal time; seconds) of both
 #                               benchmarks and the report, in a temporary directory; touches
 #                               neither bench/results nor docs nor README.md
@@ -14,8 +17,18 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${BUILD_DIR:-build}
+mode=${1:-}
+case "$mode" in
+  "" | --quick | --update-docs) ;;
+  *) echo "usage: scripts/bench.sh [--quick | --update-docs]" >&2; exit 2 ;;
+esac
 QUICK=0
-[[ "${1:-}" == "--quick" ]] && QUICK=1
+[[ "$mode" == --quick ]] && QUICK=1
+if [[ "$mode" == --update-docs ]]; then
+  results=bench/results doc=docs/benchmarks.md readme=README.md
+else
+  results=out/bench/results doc=out/bench/benchmarks.md readme=out/bench/README.md
+fi
 
 if [[ "$BUILD_DIR" == build ]]; then
   cmake --preset release >/dev/null
@@ -28,12 +41,16 @@ if [[ $QUICK == 1 ]]; then
   exec bash bench/smoke.sh "$BUILD_DIR"
 fi
 
-mkdir -p bench/results
-"$BUILD_DIR/bench/amalgam_embree_bench" --benchmark_out=bench/results/embree.json \
-  --benchmark_out_format=json 2> >(tee bench/results/embree.log >&2)
-"$BUILD_DIR/bench/amalgam_bench" --benchmark_out=bench/results/traverse.json \
+mkdir -p "$results"
+if [[ "$mode" != --update-docs ]]; then  # the generated parts are rewritten in copies
+  cp docs/benchmarks.md "$doc"
+  cp README.md "$readme"
+fi
+"$BUILD_DIR/bench/amalgam_embree_bench" --benchmark_out="$results/embree.json" \
+  --benchmark_out_format=json 2> >(tee "$results/embree.log" >&2)
+"$BUILD_DIR/bench/amalgam_bench" --benchmark_out="$results/traverse.json" \
   --benchmark_out_format=json
 
-"$BUILD_DIR/bench/amalgam_field_bench" --out bench/results/field
-python3 scripts/bench_report.py bench/results/embree.json bench/results/embree.log \
-  bench/results/field/results.json docs/benchmarks.md README.md
+"$BUILD_DIR/bench/amalgam_field_bench" --out "$results/field"
+python3 scripts/bench_report.py "$results/embree.json" "$results/embree.log" \
+  "$results/field/results.json" "$doc" "$readme"

@@ -2,10 +2,13 @@
 # Quality vs cost of amalgams on a real-mesh field.
 #
 #   scripts/quality-vs-cost.sh           full study (about 25 s on 2 cores): writes
-#                                        docs/quality-vs-cost/{results.csv, *.png} and the
-#                                        generated part of docs/quality-vs-cost.md
+#                                        out/quality-vs-cost/{results.csv, *.png} and
+#                                        out/quality-vs-cost.md (a copy of the docs page with
+#                                        its generated part rewritten); touches no docs
+#   scripts/quality-vs-cost.sh --update-docs   the same into docs/quality-vs-cost/ and
+#                                        docs/quality-vs-cost.md (regenerates the docs)
 #   scripts/quality-vs-cost.sh --quick   smoke run (tiny images) into a temporary directory;
-#                                        touches nothing under docs/
+#                                        touches nothing under docs/ or out/
 #
 # What it does: renders a reference (traditional renderer, REF_SPP samples per pixel, its own
 # seed), then, at WIDTH x HEIGHT,
@@ -18,7 +21,8 @@
 #
 # Environment: AMALGAM (binary; default build/amalgam), SCENE (default scenes/field.json),
 # WIDTH, HEIGHT (512 x 384), SPP (4), REF_SPP (32), KS ("0.5 1 2 4 8 16"), THREADS (all
-# cores), OUT (docs/quality-vs-cost), DOC (docs/quality-vs-cost.md).
+# cores), OUT (out/quality-vs-cost; with --update-docs docs/quality-vs-cost), DOC
+# (out/quality-vs-cost.md; with --update-docs docs/quality-vs-cost.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -30,11 +34,21 @@ SPP=${SPP:-4}
 REF_SPP=${REF_SPP:-32}
 KS=${KS:-"0.5 1 2 4 8 16"}
 THREADS=${THREADS:-0}
-OUT=${OUT:-docs/quality-vs-cost}
-DOC=${DOC:-docs/quality-vs-cost.md}
+mode=${1:-}
+case "$mode" in
+  "" | --quick | --update-docs) ;;
+  *) echo "usage: scripts/quality-vs-cost.sh [--quick | --update-docs]" >&2; exit 2 ;;
+esac
+if [[ "$mode" == --update-docs ]]; then
+  OUT=${OUT:-docs/quality-vs-cost}
+  DOC=${DOC:-docs/quality-vs-cost.md}
+else
+  OUT=${OUT:-out/quality-vs-cost}
+  DOC=${DOC:-out/quality-vs-cost.md}
+fi
 REF_SEED=9001  # the reference's samples differ from every measured render's (seed 0)
 
-if [[ "${1:-}" == "--quick" ]]; then
+if [[ "$mode" == --quick ]]; then
   WIDTH=64 HEIGHT=48 REF_SPP=4 KS="1 4"
   OUT=$(mktemp -d)
   DOC=$OUT/doc.md
@@ -42,9 +56,11 @@ fi
 [[ -x "$AMALGAM" ]] || { echo "quality-vs-cost: $AMALGAM not found (set AMALGAM or build first)" >&2; exit 1; }
 command -v gnuplot >/dev/null || { echo "quality-vs-cost: gnuplot not found (apt-get install gnuplot-nox)" >&2; exit 1; }
 
-mkdir -p "$OUT"
+mkdir -p "$OUT" "$(dirname "$DOC")"
+# Outside the docs, the generated part is rewritten in a copy of the page.
+[[ -f "$DOC" ]] || cp docs/quality-vs-cost.md "$DOC"
 work=$(mktemp -d)  # every render and its stats; only the figures below are kept
-trap 'rm -rf "$work"; [[ "${1:-}" == "--quick" ]] && rm -rf "$OUT"' EXIT
+trap 'rm -rf "$work"; [[ "$mode" == --quick ]] && rm -rf "$OUT"' EXIT
 thread_args=()
 [[ "$THREADS" != 0 ]] && thread_args=(--threads "$THREADS")
 

@@ -5,14 +5,17 @@
 #
 #   scripts/yardstick.sh            full run (about 10-20 minutes on 2 cores; the
 #                                   references are cached in build/yardstick/cache, so reruns
-#                                   save about a third): writes docs/yardstick/*.png and
-#                                   *.csv/json and the generated part of docs/yardstick.md
+#                                   save about a third): writes out/yardstick/*.png and
+#                                   *.csv/json and out/yardstick.md (a copy of the docs page
+#                                   with its generated part rewritten); touches no docs
+#   scripts/yardstick.sh --update-docs   the same into docs/yardstick/ and docs/yardstick.md
 #   scripts/yardstick.sh --quick    smoke run (tiny images) into a temporary directory;
-#                                   touches nothing under docs/
+#                                   touches nothing under docs/ or out/
 #
 # Environment: BENCH (default build/bench/amalgam_quality_bench), SCENE (scenes/field.json),
 # VIEWS ("aerial street"), THREADS (2), WORK (build/yardstick: results and the reference
-# cache), DOCS (docs/yardstick), DOC (docs/yardstick.md), BENCH_ARGS (more bench options, e.g.
+# cache), DOCS (out/yardstick; --update-docs: docs/yardstick), DOC (out/yardstick.md;
+# --update-docs: docs/yardstick.md), BENCH_ARGS (more bench options, e.g.
 # "--footprints 1,4 --spps 1,4,16"; the script adds --oracle-box, the box-disc oracle beside
 # the K-footprint one), BENCH_ARGS_<view> (options for one view only).
 set -euo pipefail
@@ -23,12 +26,25 @@ SCENE=${SCENE:-scenes/field.json}
 VIEWS=${VIEWS:-"aerial street"}
 THREADS=${THREADS:-2}
 WORK=${WORK:-build/yardstick}
-DOCS=${DOCS:-docs/yardstick}
-DOC=${DOC:-docs/yardstick.md}
+mode=${1:-}
+case "$mode" in
+  "" | --quick | --update-docs) ;;
+  *) echo "usage: scripts/yardstick.sh [--quick | --update-docs]" >&2; exit 2 ;;
+esac
+if [[ "$mode" == --update-docs ]]; then
+  DOCS=${DOCS:-docs/yardstick}
+  DOC=${DOC:-docs/yardstick.md}
+else
+  DOCS=${DOCS:-out/yardstick}
+  DOC=${DOC:-out/yardstick.md}
+  # Outside the docs, the generated part is rewritten in a copy of the page.
+  mkdir -p "$(dirname "$DOC")"
+  [[ -f "$DOC" || ! -f docs/$(basename "$DOC") ]] || cp "docs/$(basename "$DOC")" "$DOC"
+fi
 read -r -a extra <<<"${BENCH_ARGS:-}"
 extra+=(--oracle-box)
 quick=()
-if [[ "${1:-}" == "--quick" ]]; then
+if [[ "$mode" == --quick ]]; then
   quick=(--quick)
   WORK=$(mktemp -d)
   DOCS=$WORK/docs
@@ -40,7 +56,7 @@ fi
   { echo "yardstick: python3 matplotlib not found (apt-get install python3-matplotlib)" >&2; exit 1; }
 
 dirs=()
-command="scripts/yardstick.sh"
+command="scripts/yardstick.sh${mode:+ $mode}"
 [[ "$SCENE" != scenes/field.json ]] && command="SCENE=$SCENE DOC=$DOC DOCS=$DOCS VIEWS=\"$VIEWS\" $command"
 [[ -n "${BENCH_ARGS:-}" ]] && command+=" (BENCH_ARGS=\"$BENCH_ARGS\")"
 for view in $VIEWS; do
