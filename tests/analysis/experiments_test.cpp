@@ -311,6 +311,14 @@ TEST(Experiments, VerdictFollowsFromTheChecks) {
   EXPECT_EQ(verdict_of({ok, refuted}, "Eq. X"), Verdict::kHoldsWithCorrection);
   EXPECT_EQ(verdict_of({ok}, "Eq. X"), std::nullopt);
   EXPECT_EQ(verdict_of(std::vector<Check>{}), Verdict::kNotMeasured);
+  // Checks of the harness are not evidence: alone they measure nothing; a failed one means the
+  // measurement is not trusted (not measured), unless the evidence already says "does not hold".
+  const Check rig("loop repeated its count", 1, 1, 0, Role::kHarness);
+  const Check broken_rig("loop repeated its count", 1, 2, 0, Role::kHarness);
+  EXPECT_EQ(verdict_of({rig}), Verdict::kNotMeasured);
+  EXPECT_EQ(verdict_of({ok, rig}), Verdict::kHolds);
+  EXPECT_EQ(verdict_of({ok, broken_rig}), Verdict::kNotMeasured);
+  EXPECT_EQ(verdict_of({bad, broken_rig}), Verdict::kDoesNotHold);
   // An experiment whose scenes cannot be loaded measures nothing and says so.
   Config no_loader;
   no_loader.quick = true;

@@ -34,12 +34,14 @@ const char* to_string(Verdict v) {
 }
 
 Verdict verdict_of(const std::vector<Check>& checks) {
-  if (checks.empty()) return Verdict::kNotMeasured;
-  bool corrected = false;
+  bool corrected = false, evidence = false, harness_failed = false;
   for (const Check& c : checks) {
     if (c.role == Role::kSupports && !c.passed()) return Verdict::kDoesNotHold;
     if (c.role == Role::kRefutesPrinted && c.passed()) corrected = true;
+    if (c.role == Role::kHarness && !c.passed()) harness_failed = true;
+    evidence = evidence || is_evidence(c);
   }
+  if (!evidence || harness_failed) return Verdict::kNotMeasured;
   return corrected ? Verdict::kHoldsWithCorrection : Verdict::kHolds;
 }
 

@@ -58,8 +58,11 @@ struct Panel {
 /// What a check says about the paper. kSupports: the measurement agrees with the paper's
 /// statement (or with our correction of a printed formula) -- if it fails, the statement does
 /// not hold. kRefutesPrinted: the measurement disagrees with a formula or claim as printed --
-/// if it passes, the statement holds only with a correction.
-enum class Role { kSupports, kRefutesPrinted };
+/// if it passes, the statement holds only with a correction. kHarness: a check of the measuring
+/// apparatus, not of the paper (a timing loop repeated the count it timed; a pixel's variance
+/// falls as 1/spp): not counted as evidence; if it fails, the measurement is not trusted and
+/// the verdict is "not measured".
+enum class Role { kSupports, kRefutesPrinted, kHarness };
 
 /// A measured figure checked against a prediction: |measured - predicted| <= tolerance.
 /// `statement` names the paper statement it bears on (an id of statements(), e.g. "Eq. 12";
@@ -85,6 +88,11 @@ struct Check {
 /// an experiment needs could not be loaded).
 enum class Verdict { kHolds, kHoldsWithCorrection, kDoesNotHold, kNotMeasured };
 const char* to_string(Verdict v);
+
+/// Whether `c` is evidence about the paper (every role but kHarness).
+inline bool is_evidence(const Check& c) {
+  return c.role != Role::kHarness;
+}
 
 /// The verdict that follows from checks (never written by hand): not measured if there are
 /// none; does not hold if a kSupports check fails; else holds with correction if a

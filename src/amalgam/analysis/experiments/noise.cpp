@@ -106,7 +106,7 @@ ExperimentResult noise(const Config& c) {
     if (a[4] > 0)
       r.checks.push_back(
           {"config level " + str(configs[ci]) + ": variance x spp constant (1/spp law, 35%)",
-           b[4] * b[2], a[4] * a[2], 0.35 * a[4] * a[2]});
+           b[4] * b[2], a[4] * a[2], 0.35 * a[4] * a[2], Role::kHarness});
   }
   std::string lines;
   int better = 0, cheaper = 0;
