@@ -14,8 +14,10 @@
 #include "amalgam/io/image_decode.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  constexpr std::uint64_t kMaxTexels = std::uint64_t{1} << 20;  // small: no out-of-memory
-  constexpr std::uint32_t kMaxSide = 4096;
+  // Small limits: a header claiming a large image is refused as the helper would refuse a huge
+  // one, and decoding stays fast under the sanitizers (at 2^20 texels: 17 inputs/s, 1.6 GB).
+  constexpr std::uint64_t kMaxTexels = std::uint64_t{1} << 16;
+  constexpr std::uint32_t kMaxSide = 1024;
   amalgam::Texture t;
   std::string why;
   if (amalgam::decode_image(data, size, kMaxTexels, kMaxSide, t, why)) {

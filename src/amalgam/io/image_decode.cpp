@@ -6,6 +6,7 @@
 #include <jerror.h>  // after jpeglib.h: the warning codes (JWRN_*)
 // clang-format on
 #include <Iex.h>
+#include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfIO.h>
 #include <OpenEXR/ImfRgbaFile.h>
 #include <png.h>
@@ -21,11 +22,15 @@
 
 // stb_image (Debian's libstb-dev) for the formats without a stricter library here: libpng
 // checks every chunk's CRC and libjpeg reports a file cut short, where stb_image decodes both
-// silently, so PNG and JPEG stay with them.
+// silently, so PNG and JPEG stay with them. PNM and PIC are left out: stb_image's PNM header
+// parser overflows a signed int on a long number (undefined behaviour, found by
+// fuzz/image_fuzz.cpp), and neither is a texture format in practice.
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_NO_STDIO
 #define STBI_NO_PNG
 #define STBI_NO_JPEG
+#define STBI_NO_PNM
+#define STBI_NO_PIC
 #define STBI_MAX_DIMENSIONS (1 << 16)
 #include <stb/stb_image.h>
 
@@ -191,12 +196,53 @@ class MemoryStream final : public Imf::IStream {
   std::size_t size_, pos_ = 0;
 };
 
+/// OpenEXR sizes an attribute's value from the size the file declares before reading it, so a
+/// header claiming a 2 GB string attribute has it allocate and clear 2 GB first (10 s under
+/// the sanitizers, found by fuzz/image_fuzz.cpp). The declared sizes are checked against the
+/// bytes the file has, header by header (a multi-part file has several, then an empty one).
+bool exr_headers_fit(const std::uint8_t* d, std::size_t n, std::string& why) {
+  why = "corrupt EXR data: the header is cut short";
+  if (n < 8) return false;
+  const bool multipart = (d[5] & 0x10) != 0;  // version flag bit 12
+  std::size_t at = 8;
+  auto skip_name = [&] {  // a null-terminated name
+    while (at < n && d[at] != 0) ++at;
+    return at++ < n;
+  };
+  do {
+    for (;;) {
+      if (at >= n) return false;
+      if (d[at] == 0) {  // the end of this header
+        ++at;
+        break;
+      }
+      if (!skip_name() || !skip_name() || n - at < 4) return false;
+      std::uint32_t bytes = 0;
+      for (int k = 3; k >= 0; --k) bytes = bytes << 8 | d[at + static_cast<std::size_t>(k)];
+      at += 4;
+      if (bytes > n - at) {
+        why = "corrupt EXR data: an attribute claims " + std::to_string(bytes) +
+              " bytes, more than the file has";
+        return false;
+      }
+      at += bytes;
+    }
+  } while (multipart && at < n && d[at] != 0);
+  return true;
+}
+
 /// EXR through OpenEXR's RGBA interface (any channel type; luminance-only files as grey):
 /// linear colours, stored as 8-bit sRGB like every texture (clamped to [0, 1], as a base colour
 /// is a reflectance).
 bool decode_exr(const std::uint8_t* data, std::size_t size, std::uint64_t max_texels,
                 std::uint32_t max_side, Texture& out, std::string& why) {
+  if (!exr_headers_fit(data, size, why)) return false;
   try {
+    // OpenEXR's own limits, checked as the header is read: without them a header claiming a
+    // huge data window or tile makes it allocate line or tile buffers for it first.
+    const int side = static_cast<int>(std::min<std::uint32_t>(max_side, 1u << 30));
+    Imf::Header::setMaxImageSize(side, side);
+    Imf::Header::setMaxTileSize(side, side);
     MemoryStream stream(data, size);
     Imf::RgbaInputFile file(stream, 1);
     const Imath::Box2i win = file.dataWindow();
@@ -256,7 +302,7 @@ struct StbSource {
   }
 };
 
-/// TGA, BMP, PSD, GIF (first frame), HDR (Radiance), PIC and PNM through stb_image; HDR is
+/// TGA, BMP, PSD, GIF (first frame) and HDR (Radiance) through stb_image; HDR is
 /// linear, stored as 8-bit sRGB as an EXR is. A file shorter than its image is refused.
 bool decode_stb(const std::uint8_t* data, std::size_t size, std::uint64_t max_texels,
                 std::uint32_t max_side, Texture& out, std::string& why) {
@@ -267,7 +313,7 @@ bool decode_stb(const std::uint8_t* data, std::size_t size, std::uint64_t max_te
   const int len = static_cast<int>(size);
   int w = 0, h = 0, channels = 0;
   if (!stbi_info_from_memory(data, len, &w, &h, &channels)) {
-    why = "not an image format amalgam reads (PNG, JPEG, EXR, TGA, BMP, PSD, GIF, HDR, PIC, PNM)";
+    why = "not an image format amalgam reads (PNG, JPEG, EXR, TGA, BMP, PSD, GIF, HDR)";
     return false;
   }
   if (too_large(static_cast<std::uint64_t>(std::max(w, 0)),

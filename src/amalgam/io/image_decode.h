@@ -1,6 +1,6 @@
 #pragma once
 /// \file Decoding texture images (PNG with libpng, JPEG with libjpeg, EXR with OpenEXR, TGA,
-/// BMP, PSD, GIF, HDR, PIC and PNM with stb_image) for the mesh import
+/// BMP, PSD, GIF and HDR with stb_image) for the mesh import
 /// helper: it runs only there (apps/amalgam-import), so a corrupt image that crashes a decoder
 /// is one failed import, never a crash of amalgam.
 
