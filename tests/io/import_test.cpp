@@ -19,20 +19,13 @@
 #include "amalgam/io/mesh_import.h"
 #include "amalgam/load/load_scene.h"
 #include "amalgam/render/render.h"
+#include "test_models.h"
 
 namespace amalgam {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path kModels = "/usr/share/assimp/models";
-
-// The models come with Debian's assimp-testmodels, which scripts/deps.sh installs: missing is
-// a failure, not a skip (a skipped test guards nothing).
-#define REQUIRE_MODELS()                                            \
-  ASSERT_TRUE(fs::is_directory(kModels))                            \
-      << kModels                                                    \
-      << " is missing: install Debian's assimp-testmodels package " \
-         "(apt-get install assimp-testmodels)"
+using test::kModels;
 
 /// The directories of temp_dir, removed when the test process ends.
 struct TempDirs {

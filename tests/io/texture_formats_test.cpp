@@ -14,16 +14,13 @@
 
 #include "amalgam/io/mesh_import.h"
 #include "amalgam/io/srgb.h"
+#include "test_models.h"
 
 namespace amalgam {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path kModels = "/usr/share/assimp/models";
-
-#define REQUIRE_MODELS()                 \
-  ASSERT_TRUE(fs::is_directory(kModels)) \
-      << kModels << " is missing: install Debian's assimp-testmodels package (scripts/deps.sh)"
+using test::kModels;
 
 struct Scratch {
   fs::path dir = fs::temp_directory_path() / ("amalgam_texfmt_" + std::to_string(getpid()));
