@@ -4,66 +4,62 @@
 #include <utility>
 
 namespace amalgam {
+namespace {
 
-std::vector<Primitive> subdivide(const std::vector<Primitive>& triangles, int levels) {
-  std::vector<Primitive> out = triangles;
+/// The one midpoint split of the three subdivisions: corner values 0, 1, 2 of each triangle
+/// (`get(t, k)`, a Vec3) and their edge midpoints 3, 4, 5 (ab, bc, ca) make four triangles,
+/// in the same order for triangles and every per-corner attribute (`make(t, x, y, z)`).
+template <class T, class Get, class Make>
+std::vector<T> split_levels(const std::vector<T>& in, int levels, Get get, Make make) {
+  std::vector<T> out = in;
   for (int l = 0; l < levels; ++l) {
-    std::vector<Primitive> next;
+    std::vector<T> next;
     next.reserve(out.size() * 4);
-    for (const Primitive& t : out) {
-      const Vec3 ab = (t.a + t.b) * 0.5f, bc = (t.b + t.c) * 0.5f, ca = (t.c + t.a) * 0.5f;
-      next.push_back(Primitive::triangle(t.a, ab, ca, t.material));
-      next.push_back(Primitive::triangle(ab, t.b, bc, t.material));
-      next.push_back(Primitive::triangle(ca, bc, t.c, t.material));
-      next.push_back(Primitive::triangle(ab, bc, ca, t.material));
+    for (const T& t : out) {
+      Vec3 v[6] = {get(t, 0), get(t, 1), get(t, 2)};
+      for (int k = 0; k < 3; ++k) v[3 + k] = (v[k] + v[(k + 1) % 3]) * 0.5f;
+      for (const auto& tri :
+           {std::array{0, 3, 5}, std::array{3, 1, 4}, std::array{5, 4, 2}, std::array{3, 4, 5}})
+        next.push_back(make(t, v[tri[0]], v[tri[1]], v[tri[2]]));
     }
     out = std::move(next);
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<Primitive> subdivide(const std::vector<Primitive>& triangles, int levels) {
+  return split_levels(
+      triangles, levels,
+      [](const Primitive& t, int k) { return k == 0   ? t.a
+                                             : k == 1 ? t.b
+                                                      : t.c; },
+      [](const Primitive& t, Vec3 a, Vec3 b, Vec3 c) {
+        return Primitive::triangle(a, b, c, t.material);
+      });
 }
 
 std::vector<TexCoords> subdivide(const std::vector<TexCoords>& uvs, int levels) {
-  std::vector<TexCoords> out = uvs;
-  for (int l = 0; l < levels; ++l) {
-    std::vector<TexCoords> next;
-    next.reserve(out.size() * 4);
-    for (const TexCoords& t : out) {
-      // Vertices 0, 1, 2 = a, b, c; 3, 4, 5 = the midpoints ab, bc, ca.
-      float u[6] = {t.u[0], t.u[1], t.u[2]}, v[6] = {t.v[0], t.v[1], t.v[2]};
-      for (int k = 0; k < 3; ++k) {
-        u[3 + k] = (t.u[k] + t.u[(k + 1) % 3]) * 0.5f;
-        v[3 + k] = (t.v[k] + t.v[(k + 1) % 3]) * 0.5f;
-      }
-      for (const auto& tri :
-           {std::array{0, 3, 5}, std::array{3, 1, 4}, std::array{5, 4, 2}, std::array{3, 4, 5}}) {
-        TexCoords c;
-        for (int k = 0; k < 3; ++k) c.u[k] = u[tri[k]], c.v[k] = v[tri[k]];
-        next.push_back(c);
-      }
-    }
-    out = std::move(next);
-  }
-  return out;
+  return split_levels(
+      uvs, levels,
+      [](const TexCoords& t, int k) {
+        return Vec3{t.u[k], t.v[k], 0.0f};
+      },
+      [](const TexCoords&, Vec3 a, Vec3 b, Vec3 c) {
+        TexCoords out;
+        const Vec3 corner[3] = {a, b, c};
+        for (int k = 0; k < 3; ++k) out.u[k] = corner[k].x, out.v[k] = corner[k].y;
+        return out;
+      });
 }
 
 std::vector<VertexNormals> subdivide(const std::vector<VertexNormals>& normals, int levels) {
-  std::vector<VertexNormals> out = normals;
-  for (int l = 0; l < levels; ++l) {
-    std::vector<VertexNormals> next;
-    next.reserve(out.size() * 4);
-    for (const VertexNormals& t : out) {
-      Vec3 n[6] = {t.n[0], t.n[1], t.n[2]};  // as for the coordinates above
-      for (int k = 0; k < 3; ++k) n[3 + k] = (t.n[k] + t.n[(k + 1) % 3]) * 0.5f;
-      for (const auto& tri :
-           {std::array{0, 3, 5}, std::array{3, 1, 4}, std::array{5, 4, 2}, std::array{3, 4, 5}}) {
-        VertexNormals c;
-        for (int k = 0; k < 3; ++k) c.n[k] = n[tri[k]];
-        next.push_back(c);
-      }
-    }
-    out = std::move(next);
-  }
-  return out;
+  return split_levels(
+      normals, levels, [](const VertexNormals& t, int k) { return t.n[k]; },
+      [](const VertexNormals&, Vec3 a, Vec3 b, Vec3 c) {
+        return VertexNormals{{a, b, c}};
+      });
 }
 
 }  // namespace amalgam
