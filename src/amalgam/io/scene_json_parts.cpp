@@ -152,11 +152,13 @@ void append_mesh(SceneDescription& out, const ImportedMesh& mesh, const AffineD&
   if (textured || !out.uvs.empty()) out.uvs.resize(out.prims.size());
   const bool smooth = !mesh.normals.empty();  // geometry: kept under a replaced material too
   if (smooth || !out.normals.empty()) out.normals.resize(out.prims.size());
-  Vec3 rows[3];  // M^-T, for the normals
-  const AffineD inv = a.inverse();
-  for (int i = 0; i < 3; ++i)
-    rows[i] = Vec3{static_cast<float>(inv.m[0][i]), static_cast<float>(inv.m[1][i]),
-                   static_cast<float>(inv.m[2][i])};
+  Vec3 rows[3];  // M^-T, for the normals (only a mesh with normals needs the inverse)
+  if (smooth) {
+    const AffineD inv = a.inverse();
+    for (int i = 0; i < 3; ++i)
+      rows[i] = Vec3{static_cast<float>(inv.m[0][i]), static_cast<float>(inv.m[1][i]),
+                     static_cast<float>(inv.m[2][i])};
+  }
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
     const Primitive& t = mesh.triangles[i];
     out.prims.push_back(Primitive::triangle(a.point(t.a), a.point(t.b), a.point(t.c),
