@@ -6,8 +6,17 @@
 # traversed) and scale-sensitively (amalgams about a pixel wide rendered instead), and composes
 # out/demo.png: the images, their exact cost per pixel on one shared log scale, and the level
 # rendered at each pixel. Traditional cost grows with the scene; scale-sensitive cost does not.
+#
+# --update-docs also copies the strip to docs/img/demo.png and rewrites the README caption's
+# figures from these renders (scripts/figures.py; the docs_figures test re-measures them).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+update_docs=0
+case "${1:-}" in
+  "") ;;
+  --update-docs) update_docs=1 ;;
+  *) echo "usage: scripts/demo.sh [--update-docs]" >&2; exit 2 ;;
+esac
 bash scripts/deps.sh --demo  # the CLI's packages only; scripts/test.sh installs the rest
 # No tests or benchmarks here (their libraries are not installed yet); scripts/test.sh turns
 # them on in the same tree, whose objects it then reuses.
@@ -35,4 +44,8 @@ cat >"$out/strip.json" <<'EOF'
   {"name": "scale-sensitive-fine", "title": "1.6e10, scale-sensitive", "renderer": "scale-sensitive"}]}
 EOF
 /usr/bin/python3 scripts/demo_strip.py "$out" out/demo.png
+if ((update_docs)); then
+  cp out/demo.png docs/img/demo.png
+  /usr/bin/python3 scripts/figures.py update --only demo --demo-dir "$out"
+fi
 echo "demo strip: $(pwd)/out/demo.png (renders, cost and level images, stats: $out/)"

@@ -1,0 +1,274 @@
+#!/usr/bin/python3
+"""Figures in the README and docs that a script writes and a test re-measures.
+
+A figure in a page is marked where it stands:
+
+    <!-- fig:demo.tests.traditional.coarse -->80.9<!-- /fig -->     deterministic: a count,
+                                                                    tests per ray, a level, an
+                                                                    error of a seeded render
+    <!-- fig~:qvc.time.traditional.spp4 -->0.38<!-- /fig -->        a timing: written by the
+                                                                    same run, not compared
+
+The marks do not show in rendered Markdown. Each key's first part names the run that measures
+it (GROUPS below). `update` runs them (or reads their outputs) and rewrites every marked figure;
+`check` runs them afresh into a temporary directory and fails, naming page, key, written and
+measured value, when a deterministic figure differs, and on a key no run measures. Same seed,
+same bytes on any thread count, so a count that differs means the text is stale.
+
+Usage:
+  figures.py check  [--amalgam BIN] [--only GROUP,...]
+  figures.py update [--amalgam BIN] [--only GROUP,...] [--demo-dir DIR] [--qvc-dir DIR]
+  figures.py fill FILE --qvc-csv CSV        (scripts/quality-vs-cost.sh: the figures of its page)
+
+Groups: demo (the four renders of scripts/demo.sh: 480x360, 4 spp, about 10 s),
+experiments (the names `amalgam experiment` takes), pyexample (examples/quality_vs_cost.py
+through the Python module, build/python or $AMALGAM_PYTHON; about 3 s), qvc (scripts/quality-vs-cost.sh, about
+40 s; its generated table is compared too, timing columns left out).
+"""
+
+import argparse
+import csv
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+
+MARK = re.compile(r"<!-- fig(~?):([A-Za-z0-9_.+-]+) -->(.*?)<!-- /fig -->", re.S)
+DEMO_SIZE = ["--width", "480", "--height", "360", "--spp", "4"]
+DEMO_RUNS = [(s, r) for s in ("coarse", "fine") for r in ("traditional", "scale-sensitive")]
+# Columns of the quality-vs-cost tables that are timings (left out of the comparison).
+QVC_TIMING_COLUMNS = {"render s", "traditional s at that RMSE", "ratio"}
+
+
+def pages():
+    return [ROOT / "README.md"] + sorted((ROOT / "docs").glob("*.md"))
+
+
+def marks(text):
+    """(timing, key, value) of every figure of a page, in order."""
+    return [(m.group(1) == "~", m.group(2), m.group(3)) for m in MARK.finditer(text)]
+
+
+def fill_text(text, values):
+    """The page with every figure whose key is in values rewritten."""
+    def sub(m):
+        key = m.group(2)
+        if key not in values:
+            return m.group(0)
+        return f"<!-- fig{m.group(1)}:{key} -->{values[key]}<!-- /fig -->"
+    return MARK.sub(sub, text)
+
+
+def group_of(key):
+    return key.split(".", 1)[0]
+
+
+# --- demo: the four renders of scripts/demo.sh ------------------------------------------------
+
+def demo_render(amalgam, out):
+    out.mkdir(parents=True, exist_ok=True)
+    for scene, renderer in DEMO_RUNS:
+        name = f"{renderer}-{scene}"
+        subprocess.run([amalgam, "render", str(ROOT / f"scenes/demo-field-{scene}.json"),
+                        "--renderer", renderer, *DEMO_SIZE, "--out", str(out / f"{name}.png"),
+                        "--cost-image", str(out / f"{name}-cost.pfm"),
+                        "--level-image", str(out / f"{name}-level.pfm"),
+                        "--stats", str(out / f"{name}.json"), "--quiet"], check=True)
+
+
+def exp10(x):
+    """1.6·10^10 as the README writes it."""
+    e = len(str(int(x))) - 1
+    return f"{x / 10 ** e:.1f}·10^{e}"
+
+
+def demo_values(out):
+    import numpy as np
+    import pfm
+    v = {}
+    tris = {}
+    levels = []
+    for scene, renderer in DEMO_RUNS:
+        st = json.loads((out / f"{renderer}-{scene}.json").read_text())
+        v[f"demo.tests.{renderer}.{scene}"] = f"{st['per_primary_ray']['mean']:.1f}"
+        tris[scene] = st["scene"]["primitives"]
+        if renderer == "scale-sensitive":
+            lv = pfm.read_pfm(out / f"{renderer}-{scene}-level.pfm")[:, :, 0]
+            levels.append(np.rint(lv[lv >= 0]))
+    for scene, n in tris.items():
+        v[f"demo.triangles.{scene}"] = exp10(n)
+    v["demo.growth"] = f"{tris['fine'] / tris['coarse']:.0f}x"
+    rendered = np.concatenate(levels)
+    v["demo.levels"] = f"{int(rendered.min())}-{int(rendered.max())}"
+    return v
+
+
+# --- experiments: the names `amalgam experiment` takes ----------------------------------------
+
+def experiment_values(amalgam):
+    text = subprocess.run([amalgam, "experiment", "--help"], check=True, capture_output=True,
+                          text=True).stdout
+    names = re.search(r"one of: ([a-zA-Z, -]+)", text).group(1).split(", ")
+    return {"experiments.count": str(len(names))}
+
+
+# --- pyexample: examples/quality_vs_cost.py (the Python module) ------------------------------
+
+def pyexample_values(amalgam, tmp):
+    module = Path(os.environ.get("AMALGAM_PYTHON", Path(amalgam).resolve().parent / "python"))
+    env = dict(os.environ, PYTHONPATH=str(module))
+    text = subprocess.run([sys.executable, str(ROOT / "examples/quality_vs_cost.py"),
+                           str(tmp / "quality_vs_cost.png")], env=env, check=True,
+                          capture_output=True, text=True).stdout
+    v = {}
+    for m in re.finditer(r"footprint\s+([0-9.]+): +([0-9.]+) tests/sample, "
+                         r"RMSE ([0-9.]+), SSIM ([0-9.]+)", text):
+        k = m.group(1)
+        v[f"pyexample.tests.{k}"], v[f"pyexample.rmse.{k}"], v[f"pyexample.ssim.{k}"] = \
+            m.group(2), m.group(3), m.group(4)
+    v["pyexample.tests.full"] = f"{float(re.search(r'full detail *: +([0-9.]+)', text).group(1)):.0f}"
+    return v
+
+
+# --- qvc: scripts/quality-vs-cost.sh ----------------------------------------------------------
+
+def qvc_values(csv_path):
+    """The figures the quality-vs-cost page quotes in prose, from its results.csv."""
+    rows = {r["name"]: r for r in csv.DictReader(open(csv_path))}
+    v = {}
+    for name, r in rows.items():
+        v[f"qvc.rmse.{name}"] = f"{float(r['rmse']):.3f}"
+        v[f"qvc.tests.{name}"] = f"{float(r['tests_per_ray_mean']):.1f}"
+        v[f"qvc.p50.{name}"] = r["tests_per_ray_p50"]
+        v[f"qvc.p99.{name}"] = f"{int(float(r['tests_per_ray_p99'])):,}"
+        v[f"qvc.primitive.{name}"] = f"{int(r['primitive_tests']) / 1e6:.2f} M"
+        v[f"qvc.time.{name}"] = f"{float(r['render_s']):.2f}"
+    return v
+
+
+def qvc_run(amalgam, out):
+    env = dict(os.environ, AMALGAM=amalgam, OUT=str(out), DOC=str(out / "doc.md"))
+    subprocess.run(["bash", str(ROOT / "scripts/quality-vs-cost.sh")], env=env, check=True,
+                   cwd=ROOT)
+    return out / "results.csv", out / "doc.md"
+
+
+def mask_timing_columns(text):
+    """The page with the timing columns of its tables blanked."""
+    lines = text.splitlines()
+    masked, header = [], None
+    for line in lines:
+        if line.startswith("|"):
+            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            if header is None:
+                header = cells
+            elif not all(set(c) <= set("-: ") for c in cells):
+                cells = ["~" if i < len(header) and header[i] in QVC_TIMING_COLUMNS else c
+                         for i, c in enumerate(cells)]
+            masked.append("| " + " | ".join(cells) + " |")
+        else:
+            header = None
+            masked.append(MARK.sub(lambda m: "~" if m.group(1) else m.group(0), line))
+    return "\n".join(masked)
+
+
+# --- check / update ---------------------------------------------------------------------------
+
+def measure(groups, amalgam, tmp, demo_dir=None, qvc_dir=None):
+    """Every figure of the groups, measured (or read from the given directories)."""
+    values, qvc_doc = {}, None
+    if "demo" in groups:
+        d = Path(demo_dir) if demo_dir else tmp / "demo"
+        if not demo_dir:
+            demo_render(amalgam, d)
+        values.update(demo_values(d))
+    if "experiments" in groups:
+        values.update(experiment_values(amalgam))
+    if "pyexample" in groups:
+        values.update(pyexample_values(amalgam, tmp))
+    if "qvc" in groups:
+        if qvc_dir:
+            values.update(qvc_values(Path(qvc_dir) / "results.csv"))
+        else:
+            csv_path, qvc_doc = qvc_run(amalgam, tmp / "qvc")
+            values.update(qvc_values(csv_path))
+    return values, qvc_doc
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("mode", choices=["check", "update", "fill"])
+    ap.add_argument("file", nargs="?")
+    ap.add_argument("--amalgam", default=os.environ.get("AMALGAM", str(ROOT / "build/amalgam")))
+    ap.add_argument("--only", default="demo,experiments,pyexample,qvc")
+    ap.add_argument("--demo-dir")
+    ap.add_argument("--qvc-dir")
+    ap.add_argument("--qvc-csv")
+    a = ap.parse_args()
+
+    if a.mode == "fill":
+        path = Path(a.file)
+        path.write_text(fill_text(path.read_text(), qvc_values(a.qvc_csv)))
+        return 0
+
+    groups = set(a.only.split(","))
+    known = {"demo", "experiments", "pyexample", "qvc"}
+    if not groups <= known:
+        sys.exit(f"figures.py: unknown group {sorted(groups - known)}; known: {sorted(known)}")
+    with tempfile.TemporaryDirectory() as tmp:
+        values, qvc_doc = measure(groups, a.amalgam, Path(tmp), a.demo_dir, a.qvc_dir)
+        qvc_fresh = (fill_text(qvc_doc.read_text(), values) if qvc_doc else None)
+    problems, checked = [], 0
+    for page in pages():
+        text = page.read_text()
+        rel = page.relative_to(ROOT)
+        if a.mode == "update":
+            new = fill_text(text, values)
+            if new != text:
+                page.write_text(new)
+                print(f"figures: rewrote {rel}")
+            continue
+        for timing, key, written in marks(text):
+            if group_of(key) not in known:
+                problems.append(f"{rel}: figure {key}: no run measures it")
+            elif group_of(key) not in groups or timing:
+                continue
+            elif key not in values:
+                problems.append(f"{rel}: figure {key}: no run measures it")
+            else:
+                checked += 1
+                if values[key] != written:
+                    problems.append(f"{rel}: figure {key}: the page says {written!r}, "
+                                    f"a fresh run gives {values[key]!r}")
+    if a.mode == "check" and qvc_fresh is not None:
+        page = ROOT / "docs/quality-vs-cost.md"
+        old = mask_timing_columns(page.read_text()).splitlines()
+        new = mask_timing_columns(qvc_fresh).splitlines()
+        for i, (o, n) in enumerate(zip(old, new)):
+            if o != n:
+                problems.append(f"docs/quality-vs-cost.md:{i + 1}: the page says {o!r}, "
+                                f"a fresh run gives {n!r}")
+        if len(old) != len(new):
+            problems.append("docs/quality-vs-cost.md: a fresh run gives "
+                            f"{len(new)} lines, the page has {len(old)}")
+    if a.mode == "check":
+        for p in problems:
+            print(p, file=sys.stderr)
+        print(f"figures: {checked} figures checked in groups {sorted(groups)}, "
+              f"{len(problems)} stale", file=sys.stderr)
+        if problems:
+            print("figures: regenerate with scripts/demo.sh --update-docs, "
+                  "scripts/quality-vs-cost.sh --update-docs or scripts/figures.py update",
+                  file=sys.stderr)
+            return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
