@@ -4,7 +4,8 @@
 #
 #   scripts/deps.sh          everything the default build and its tests use: the CLI with
 #                            --tracer embree, MPI, the Python module, plots (gnuplot,
-#                            matplotlib, pandas), GoogleTest, Google Benchmark, pytest, qemu-user
+#                            matplotlib, pandas), GoogleTest, Google Benchmark, pytest, Jupyter's
+#                            nbconvert and IPython kernel (the example notebook), qemu-user
 #                            (the portable copy on a CPU without AVX), Debian's Assimp test models
 #   scripts/deps.sh --demo   only what scripts/demo.sh needs (the first Quick start command): the
 #                            CLI with Embree, the Assimp test models (its herd is Wuson.ply),
@@ -27,7 +28,7 @@ packages=(
 if [ "$mode" != --demo ]; then
   packages+=(
     libgtest-dev libbenchmark-dev gnuplot-nox qemu-user
-    pybind11-dev python3-dev python3-pytest python3-pandas
+    pybind11-dev python3-dev python3-pytest python3-pandas jupyter-nbconvert python3-ipykernel
     libopenmpi-dev openmpi-bin
   )
 fi
