@@ -21,7 +21,9 @@ Usage:
   figures.py fill FILE --qvc-csv CSV        (scripts/quality-vs-cost.sh: the figures of its page)
 
 Groups: demo (the four renders of scripts/demo.sh: 480x360, 4 spp, about 10 s),
-experiments (the names `amalgam experiment` takes), pyexample (examples/quality_vs_cost.py
+experiments (the names `amalgam experiment` takes), counts (the README's exact counts: a line
+traced, prisms rendered, about 5 s), embree (the pixels where --tracer embree differs from the
+traditional renderer; needs a build with Embree), pyexample (examples/quality_vs_cost.py
 through the Python module, build/python or $AMALGAM_PYTHON; about 3 s), qvc (scripts/quality-vs-cost.sh, about
 40 s; its generated table is compared too, timing columns left out).
 """
@@ -29,6 +31,7 @@ through the Python module, build/python or $AMALGAM_PYTHON; about 3 s), qvc (scr
 import argparse
 import csv
 import json
+import math
 import os
 import re
 import subprocess
@@ -118,6 +121,92 @@ def experiment_values(amalgam):
     return {"experiments.count": str(len(names))}
 
 
+# --- counts: the README's "Exact counts, measured" ----------------------------------------
+
+def stats_of(amalgam, tmp, *args):
+    out = subprocess.run([amalgam, "render", *args, "--out", str(tmp / "counts.png"),
+                          "--stats", "-", "--quiet"], check=True, capture_output=True,
+                         text=True).stdout
+    return json.loads(out)
+
+
+def counts_values(amalgam, tmp):
+    tr = json.loads(subprocess.run([amalgam, "trace", "builtin:line", "--set", "n=3", "--set",
+                                    "depth=6", "--renderer", "traditional"], check=True,
+                                   capture_output=True, text=True).stdout)
+    v = {"counts.line.primary": str(tr["tests"]["primary"]),
+         "counts.line.shadow": str(tr["tests"]["shadow"])}
+    small = ["--width", "128", "--height", "128", "--spp", "1"]
+    for depth in (6, 12):
+        st = stats_of(amalgam, tmp, "builtin:prisms", "--set", f"depth={depth}", "--level", "4",
+                      *small)
+        v[f"counts.level4.{depth}"] = f"{st['per_primary_ray']['mean']:.5f}"
+        v[f"counts.P.{depth}"] = (f"{st['scene']['primitives']:,}".replace(",", " ")
+                                  if depth == 6 else exp10(st["scene"]["primitives"]))
+        st = stats_of(amalgam, tmp, "builtin:prisms", "--set", f"depth={depth}",
+                      "--renderer", "traditional", *small)
+        v[f"counts.traditional.{depth}"] = f"{st['per_primary_ray']['mean']:.1f}"
+    for depth in (11, 12):
+        st = stats_of(amalgam, tmp, "builtin:prisms", "--set", f"depth={depth}", "--set",
+                      "view=corner", "--width", "512", "--height", "512", "--spp", "4")
+        v[f"counts.corner.{depth}"] = f"{st['per_primary_ray']['mean']:.1f}"
+        v[f"counts.corner.P.{depth}"] = exp10(st["scene"]["primitives"])
+        v[f"counts.corner.time.{depth}"] = f"{st['time_s']['render']:.1f}"
+        v[f"counts.corner.rss.{depth}"] = f"{st['peak_memory_bytes'] / 2 ** 20:.0f}"
+    st = stats_of(amalgam, tmp, str(ROOT / "scenes/field.json"), "--width", "64", "--height",
+                  "48", "--spp", "1")
+    t = st["time_s"]
+    v["counts.field.setup"] = f"{t['load'] + t['build'] + t['bake']:.2f}"
+    v["counts.field.rss"] = f"{st['peak_memory_bytes'] / 2 ** 20:.0f}"
+    v["counts.field.triangles"] = exp10(st["scene"]["primitives"])
+    return v
+
+
+# --- embree: where --tracer embree and the traditional renderer differ -----------------------
+
+EMBREE_SCENES = {"fine": "scenes/demo-field-fine.json", "coarse": "scenes/demo-field-coarse.json",
+                 "field": "scenes/field.json", "spider": "scenes/spider-field.json",
+                 "grid": "scenes/wuson-grid.json", "spheres": "scenes/spheres.json",
+                 "line": "builtin:line", "poisson": "builtin:poisson", "prisms": "builtin:prisms",
+                 "wuson": "/usr/share/assimp/models/PLY/Wuson.ply"}
+
+
+def sig2(x):
+    """A non-negative figure to two significant digits, never in exponent form."""
+    if x == 0:
+        return "0"
+    digits = max(0, 1 - int(math.floor(math.log10(x))))
+    return f"{x:.{digits}f}"
+
+
+def embree_values(amalgam, tmp):
+    """The agreement of --tracer embree with the traditional renderer, 1 spp, linear PFM."""
+    import numpy as np
+    import pfm
+    v = {}
+    for key, scene in EMBREE_SCENES.items():
+        for w, h in ((128, 96), (512, 384)):
+            imgs = []
+            for tracer in ("amalgam", "embree"):
+                path = tmp / f"embree-{tracer}.pfm"
+                src = scene if scene.startswith(("builtin:", "/")) else str(ROOT / scene)
+                subprocess.run([amalgam, "render", src, "--renderer", "traditional", "--tracer",
+                                tracer, "--width", str(w), "--height", str(h), "--spp", "1",
+                                "--out", str(path), "--quiet"], check=True)
+                imgs.append(pfm.read_pfm(path).astype(np.float64))
+            delta = np.abs(imgs[0] - imgs[1]).max(axis=2)
+            rmse = float(np.sqrt(np.mean((imgs[0] - imgs[1]) ** 2)))
+            v[f"embree.rmse{w}.{key}"] = sig2(rmse)
+            if w == 512:
+                v[f"embree.over005.{key}"] = str(int((delta > 0.05).sum()))
+                if key == "fine":
+                    v["embree.pixels"] = str(int((delta > 0).sum()))
+                    v["embree.pixels.visible"] = str(int((delta > 0.01).sum()))
+                    v["embree.total"] = f"{delta.size:,}"
+                    v["embree.rmse"] = f"{rmse:.4f}"
+    return v
+
+
 # --- pyexample: examples/quality_vs_cost.py (the Python module) ------------------------------
 
 def pyexample_values(amalgam, tmp):
@@ -192,6 +281,10 @@ def measure(groups, amalgam, tmp, demo_dir=None, qvc_dir=None):
         values.update(experiment_values(amalgam))
     if "pyexample" in groups:
         values.update(pyexample_values(amalgam, tmp))
+    if "counts" in groups:
+        values.update(counts_values(amalgam, tmp))
+    if "embree" in groups:
+        values.update(embree_values(amalgam, tmp))
     if "qvc" in groups:
         if qvc_dir:
             values.update(qvc_values(Path(qvc_dir) / "results.csv"))
@@ -206,7 +299,7 @@ def main():
     ap.add_argument("mode", choices=["check", "update", "fill"])
     ap.add_argument("file", nargs="?")
     ap.add_argument("--amalgam", default=os.environ.get("AMALGAM", str(ROOT / "build/amalgam")))
-    ap.add_argument("--only", default="demo,experiments,pyexample,qvc")
+    ap.add_argument("--only", default="demo,experiments,counts,embree,pyexample,qvc")
     ap.add_argument("--demo-dir")
     ap.add_argument("--qvc-dir")
     ap.add_argument("--qvc-csv")
@@ -218,7 +311,7 @@ def main():
         return 0
 
     groups = set(a.only.split(","))
-    known = {"demo", "experiments", "pyexample", "qvc"}
+    known = {"demo", "experiments", "counts", "embree", "pyexample", "qvc"}
     if not groups <= known:
         sys.exit(f"figures.py: unknown group {sorted(groups - known)}; known: {sorted(known)}")
     with tempfile.TemporaryDirectory() as tmp:
