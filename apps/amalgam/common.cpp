@@ -15,8 +15,7 @@
 namespace amalgam::cli {
 
 void CommonOptions::add_to(CLI::App& app) {
-  app.add_option("scene", scene, "builtin:NAME, a scene .json or a mesh file")->required();
-  app.add_option("--set", sets, "builtin scene parameter key=value (repeatable)");
+  add_scene_to(app);
   renderer_option =
       app.add_option("--renderer", renderer,
                      "scale-sensitive (default), traditional, or volumetric (objects as "
@@ -53,6 +52,15 @@ void CommonOptions::add_to(CLI::App& app) {
                  "amalgam (default) or embree: Intel Embree 3 at full detail, same shading "
                  "(docs/embree.md)")
       ->check(CLI::IsMember({"amalgam", "embree"}));
+  add_view_to(app);
+}
+
+void CommonOptions::add_scene_to(CLI::App& app) {
+  app.add_option("scene", scene, "builtin:NAME, a scene .json or a mesh file")->required();
+  app.add_option("--set", sets, "builtin scene parameter key=value (repeatable)");
+}
+
+void CommonOptions::add_view_to(CLI::App& app) {
   app.add_option("--seed", seed, "seed of all randomness, 0 .. 2^64-1 (default 0)");
   app.add_option("--threads", threads, "worker threads (default: all cores)")
       ->check(non_negative_int());

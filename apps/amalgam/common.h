@@ -47,6 +47,11 @@ struct CommonOptions {
 
   /// Registers SCENE, --set and the renderer options of docs/cli.md on `app`.
   void add_to(CLI::App& app);
+  /// Only SCENE and --set (add_to's first part).
+  void add_scene_to(CLI::App& app);
+  /// Only --seed, --threads, the view options, --smooth-normals and --light-samples (add_to's
+  /// last part): what a command that chooses the renderers itself (advise) takes.
+  void add_view_to(CLI::App& app);
   /// Converts the parsed text into `options`; throws InputError on bad values, and on options
   /// --tracer embree cannot honour (it renders at full detail) or a build without Embree.
   void finish();
@@ -105,6 +110,17 @@ int run_scenes();
 /// bundled_scenes_dir says); a part not measured is a warning and exit 1 unless `allow_partial`.
 int run_experiment(const std::string& name, const std::string& out_dir, bool quick, int threads,
                    const std::string& scenes_dir, bool allow_partial);
+
+/// The options of `advise` beyond the scene and view ones (docs/cli.md).
+struct AdviseOptions {
+  int width = 320, height = 240;
+  double seconds = 0;       ///< time per renderer; 0: that of full detail at 16 spp
+  int reference_spp = 256;  ///< the converged estimate's samples (full detail, stratified)
+  std::string out;          ///< the strip PNG; empty: none
+  std::string json;         ///< the table as JSON (- for stdout); empty: none
+  std::string keep;         ///< a directory for every render and the reference (PFM)
+};
+int run_advise(CommonOptions& common, const AdviseOptions& advise);
 
 /// The arguments of `compare`.
 struct CompareOptions {

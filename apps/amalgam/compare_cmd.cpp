@@ -14,6 +14,7 @@
 #include "amalgam/builtin/params.h"
 #include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
+#include "amalgam/io/legend.h"
 #include "amalgam/util/atomic_file.h"
 #include "common.h"
 
@@ -67,8 +68,12 @@ int run_compare(const CompareOptions& o) {
   const ImageComparison c = compare_images(a, b, wa, ha);
 
   double vmax = 0;
-  if (!o.error_image.empty())
-    write_image(o.error_image, wa, ha, false_colour(error_map(a, b), false, &vmax));
+  if (!o.error_image.empty()) {
+    const std::vector<Vec3> colours = false_colour(error_map(a, b), false, &vmax);
+    const Canvas c = with_linear_legend(colours, wa, ha, vmax, "error (RMS over R, G, B), linear",
+                                        "error, linear");
+    write_image(o.error_image, c.width, c.height, c.pixels);
+  }
 
   // One list of (key, value) for both outputs, so the text and JSON keys are the same.
   nlohmann::ordered_json j;

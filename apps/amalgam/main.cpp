@@ -1,4 +1,4 @@
-/// The `amalgam` command line: render, trace, scenes, experiment, compare (see docs/cli.md).
+/// The `amalgam` command line: render, trace, scenes, experiment, compare, advise (docs/cli.md).
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -145,6 +145,31 @@ int main(int argc, char** argv) {
                       "write the per-pixel RMS error in false colour (.png, .exr or .pfm)");
   compare->add_flag("--json", cmp.json, "print the figures as JSON");
 
+  cli::CommonOptions advise_opts;
+  cli::AdviseOptions adv;
+  CLI::App* advise = app.add_subcommand(
+      "advise",
+      "should I use amalgams on this scene? renders full detail, Embree (where built) and the "
+      "level-of-detail renderers for equal time, prints each one's error x time against a "
+      "converged full-detail estimate, and writes a side-by-side strip");
+  advise_opts.add_scene_to(*advise);
+  advise_opts.add_view_to(*advise);
+  advise->add_option("--width", adv.width, "image width (default 320)")->check(cli::positive_int());
+  advise->add_option("--height", adv.height, "image height (default 240)")
+      ->check(cli::positive_int());
+  advise
+      ->add_option("--time", adv.seconds,
+                   "render seconds per renderer (default: what full detail takes for 16 spp)")
+      ->check(cli::seconds_in(1e-3, 86400, "[0.001, 86400]"));
+  advise
+      ->add_option("--reference-spp", adv.reference_spp,
+                   "samples per pixel of the converged full-detail estimate (default 256)")
+      ->check(cli::positive_int());
+  advise->add_option("--out", adv.out, "the side-by-side strip (.png): images, cost, levels");
+  advise->add_option("--json", adv.json, "write the table as JSON to FILE, or - for stdout");
+  advise->add_option("--keep", adv.keep,
+                     "write every render and the reference as PFM into this directory");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -169,6 +194,7 @@ int main(int argc, char** argv) {
       return cli::run_experiment(exp_name, exp_out, exp_quick, exp_threads, exp_scenes,
                                  exp_partial);
     if (compare->parsed()) return cli::run_compare(cmp);
+    if (advise->parsed()) return cli::run_advise(advise_opts, adv);
     return cli::run_scenes();
   } catch (const std::bad_alloc&) {
     std::cerr << "amalgam: out of memory while " << cli::activity() << "\n";

@@ -233,7 +233,7 @@ TEST_F(CompareCli, JsonAndErrorImage) {
   int ew = 0, eh = 0;
   const std::vector<Vec3> err = read_image(e, ew, eh);
   ASSERT_EQ(ew, w);
-  ASSERT_EQ(eh, h);
+  ASSERT_EQ(eh, h + 1 + 6 + 11) << "the picture and its legend: bar and numbers (io/legend.h)";
   const auto srgb8 = [](float v) {
     return static_cast<int>(
         std::lround(255 * (v <= 0.0031308f ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055)));

@@ -253,7 +253,8 @@ TEST(RenderOutputs, CostPngHasAColourBarAndAFixedRangeGivesTheSameColourForTheSa
   const std::vector<amalgam::Vec3> raw_b = amalgam::read_image((d / "cb.pfm").string(), w, h);
   const std::vector<amalgam::Vec3> png_a = png_pixels(d / "ca.png", w, h);
   ASSERT_EQ(w, 40);
-  ASSERT_EQ(h, 30 + 1 + 6) << "the picture, one black row, a colour bar of 6 rows";
+  ASSERT_EQ(h, 30 + 1 + 6 + 11)
+      << "the picture, one black row, a colour bar of 6 rows, a row of its numbers";
   const std::vector<amalgam::Vec3> png_b = png_pixels(d / "cb.png", w, h);
   int same = 0;
   for (int i = 0; i < 40 * 30; ++i)
@@ -270,7 +271,7 @@ TEST(RenderOutputs, CostPngHasAColourBarAndAFixedRangeGivesTheSameColourForTheSa
   }
 
   // The bar: its bottom row runs through viridis left to right, luminance rising.
-  const int bottom = h - 1;
+  const int bottom = 30 + 1 + 6 - 1;
   float last = -1.0f;
   for (int x = 0; x < w; ++x) {
     const amalgam::Vec3 c = png_a[static_cast<std::size_t>(bottom) * w + x];

@@ -17,7 +17,7 @@
 #include "test_models.h"
 
 namespace amalgam {
-namespace {
+namespace texture_formats_test {
 
 namespace fs = std::filesystem;
 using test::kModels;
@@ -152,5 +152,5 @@ TEST(TextureFormats, TheColladaDuckIsTextured) {
     EXPECT_EQ(line.find("cannot be read"), std::string::npos) << line;
 }
 
-}  // namespace
+}  // namespace texture_formats_test
 }  // namespace amalgam

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "amalgam/io/exr.h"
+#include "amalgam/io/legend.h"
 #include "amalgam/util/atomic_file.h"
 #include "amalgam/util/version.h"
 
@@ -76,9 +77,11 @@ double write_render_exr(const std::string& path, const RenderOutput& r, const Im
 void write_cost_image(const std::string& path, const RenderOutput& r, const LogRange& range) {
   if (is_png_path(path)) {
     int h = 0;
-    const std::vector<Vec3> img =
-        with_colour_bar(log_colours(r.cost, range), r.width, r.height, range, h);
-    write_image(path, r.width, h, img,
+    Canvas c{r.width, 0, with_colour_bar(log_colours(r.cost, range), r.width, r.height, range, h)};
+    c.height = h;
+    append_labels(c, log_bar_labels(range, r.width), "intersection tests per sample, log scale",
+                  "tests/sample (log)");
+    write_image(path, c.width, c.height, c.pixels,
                 {{"Software", std::string("amalgam ") + version()},
                  {"amalgam:cost-range", number(range.min) + "," + number(range.max)},
                  {"amalgam:cost-scale", "log"},
@@ -87,7 +90,7 @@ void write_cost_image(const std::string& path, const RenderOutput& r, const LogR
                   "intersection tests per primary sample (its shadow rays included), mean over "
                   "the pixel's samples, viridis on a log scale from " +
                       number(range.min) + " to " + number(range.max) +
-                      "; the bottom strip is the colour bar"}});
+                      "; below the picture: the colour bar, its numbers and its title"}});
     return;
   }
   std::vector<float> raw(r.cost.size());
@@ -100,22 +103,24 @@ void write_level_image(const std::string& path, const RenderOutput& r, int max_l
     write_image(path, r.width, r.height, grey(r.level));
     return;
   }
+  const Vec3 nothing{0, 0, 0}, primitive{0.6f, 0.6f, 0.6f};
   std::vector<Vec3> img(r.level.size());
   for (std::size_t i = 0; i < img.size(); ++i) {
     const float l = r.level[i];
     if (l == kLevelNothing)
-      img[i] = {0, 0, 0};
+      img[i] = nothing;
     else if (l == kLevelPrimitive)
-      img[i] = {0.6f, 0.6f, 0.6f};
+      img[i] = primitive;
     else
       img[i] = viridis(max_level > 0 ? l / max_level : 0.0);
   }
-  write_image(path, r.width, r.height, img,
+  const Canvas c = with_level_legend(img, r.width, r.height, max_level, primitive, nothing);
+  write_image(path, c.width, c.height, c.pixels,
               {{"Software", std::string("amalgam ") + version()},
                {"amalgam:level-range", "0," + std::to_string(max_level)},
-               {"Description", "rendered level: viridis from level 0 to level " +
-                                   std::to_string(max_level) +
-                                   "; light grey: primitives; black: nothing hit"}});
+               {"Description",
+                "rendered level: viridis from level 0 to level " + std::to_string(max_level) +
+                    "; light grey: primitives; black: nothing hit; the legend below the picture"}});
 }
 
 }  // namespace amalgam

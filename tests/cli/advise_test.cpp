@@ -1,0 +1,106 @@
+// `amalgam advise`: the renderers it compares, the figures it prints against what `compare`
+// and `render` measure on the same images, its strip, and its refusals (docs/cli.md).
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "amalgam/io/image.h"
+#include "amalgam/render/tracer.h"
+#include "cli_support.h"
+
+namespace amalgam {
+namespace advise_test {
+
+namespace fs = std::filesystem;
+using test::run_command;
+using test::scratch_dir;
+using test::slurp;
+
+test::CommandResult amalgam_cli(const std::string& args) {
+  return run_command(std::string(AMALGAM_BINARY) + " " + args + " 2>&1");
+}
+
+double rmse_of(const fs::path& a, const fs::path& b) {
+  int w = 0, h = 0;
+  const std::vector<Vec3> x = read_image(a.string(), w, h), y = read_image(b.string(), w, h);
+  double s = 0;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    for (int k = 0; k < 3; ++k) s += (double(x[i][k]) - y[i][k]) * (double(x[i][k]) - y[i][k]);
+  return std::sqrt(s / (3.0 * x.size()));
+}
+
+// On a small scene: every renderer is measured, the RMSE it reports is that of the image it
+// kept against the reference it kept, full detail is 1x itself, the ratios are MSE x time
+// ratios, the tests per ray are those `render` reports for the same options, and the strip has
+// one column per renderer plus the reference.
+TEST(Advise, MeasuresEveryRendererAgainstAConvergedEstimate) {
+  const fs::path d = scratch_dir("amalgam-advise");
+  const std::string args =
+      "advise builtin:prisms --set depth=5 --width 64 --height 48 "
+      "--reference-spp 32 --time 0.02 --threads 2 --keep " +
+      (d / "keep").string() + " --out " + (d / "strip.png").string() + " --json " +
+      (d / "a.json").string();
+  const test::CommandResult r = amalgam_cli(args);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("full detail"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("on this view"), std::string::npos) << "a verdict: " << r.out;
+  const auto j = nlohmann::json::parse(slurp(d / "a.json"));
+  const auto& rs = j["renderers"];
+  ASSERT_EQ(rs.size(), have_embree() ? 5u : 4u);
+  EXPECT_EQ(rs[0]["key"], "traditional");
+  EXPECT_DOUBLE_EQ(rs[0]["vs_full_detail"].get<double>(), 1.0);
+  const double base =
+      std::pow(rs[0]["rmse"].get<double>(), 2) * rs[0]["render_seconds"].get<double>();
+  for (const auto& m : rs) {
+    const std::string key = m["key"];
+    EXPECT_GE(m["spp"].get<int>(), 1) << key;
+    EXPECT_NEAR(m["rmse"].get<double>(),
+                rmse_of(d / "keep" / (key + ".pfm"), d / "keep" / "reference.pfm"), 1e-6)
+        << key;
+    EXPECT_NEAR(m["vs_full_detail"].get<double>(),
+                base / (std::pow(m["rmse"].get<double>(), 2) * m["render_seconds"].get<double>()),
+                1e-9)
+        << key;
+  }
+  // Tests per ray: those of a plain render with the same options and spp.
+  const auto& k1 = rs[have_embree() ? 2 : 1];
+  ASSERT_EQ(k1["key"], "scale-sensitive-k1-stochastic");
+  const test::CommandResult plain = run_command(
+      std::string(AMALGAM_BINARY) +
+      " render builtin:prisms --set depth=5 --width 64 --height 48 --sampler stratified --quiet "
+      "--footprint 1 --spp " +
+      std::to_string(k1["spp"].get<int>()) + " --out " + (d / "k1.pfm").string() + " --stats -");
+  ASSERT_EQ(plain.status, 0);
+  const auto st = nlohmann::json::parse(plain.out);
+  EXPECT_DOUBLE_EQ(k1["tests_per_primary_ray"].get<double>(),
+                   st["per_primary_ray"]["mean"].get<double>());
+  EXPECT_EQ(slurp(d / "k1.pfm"), slurp(d / "keep" / "scale-sensitive-k1-stochastic.pfm"))
+      << "the same image as render gives";
+  int w = 0, h = 0;
+  read_image((d / "strip.png").string(), w, h);
+  EXPECT_EQ(w, static_cast<int>(rs.size() + 1) * 64 + static_cast<int>(rs.size()) * 4);
+  EXPECT_GT(h, 3 * 48);
+}
+
+// Outputs are checked before any work; options that choose a renderer are not advise's.
+TEST(Advise, RefusesBadOutputsAndRendererOptions) {
+  const fs::path d = scratch_dir("amalgam-advise");
+  for (const std::string& bad : std::vector<std::string>{
+           "advise builtin:prisms --out " + (d / "x.exr").string(),
+           "advise builtin:prisms --out " + (d / "no/such/dir/x.png").string(),
+           "advise builtin:prisms --renderer traditional", "advise builtin:prisms --width 0",
+           "advise builtin:prisms --time 0"}) {
+    const test::CommandResult r = amalgam_cli(bad);
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << bad << ": " << r.out;
+  }
+}
+
+}  // namespace advise_test
+}  // namespace amalgam
