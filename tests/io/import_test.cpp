@@ -503,8 +503,21 @@ TEST(SceneFile, ErrorsNameTheJsonPointer) {
             0u);
   EXPECT_EQ(json_error(R"({"boxes": [{"min": [0, 0, 0], "max": [1, 1, 1], "material": "x"}]})"),
             "scene.json: /boxes/0/material: unknown material 'x' (no materials are defined)");
+  EXPECT_EQ(json_error(R"({)" + sphere + R"(, "lights": [{"type": "area"}]})"),
+            "scene.json: /lights/0/type: expected \"point\", \"directional\", \"spot\" or "
+            "\"sky\", found \"area\"");
   EXPECT_EQ(json_error(R"({)" + sphere + R"(, "lights": [{"type": "spot"}]})"),
-            "scene.json: /lights/0/type: expected \"point\" or \"directional\", found \"spot\"");
+            "scene.json: /lights/0: missing key 'position'");
+  EXPECT_EQ(
+      json_error(R"({)" + sphere +
+                 R"(, "lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, -1, 0],
+                       "intensity": 1, "inner_deg": 50, "outer_deg": 40}]})"),
+      "scene.json: /lights/0/inner_deg: expected a number in degrees, [0, outer_deg], found 50");
+  EXPECT_EQ(json_error(R"({)" + sphere + R"(, "lights": [{"type": "sky"}, {"type": "sky"}]})"),
+            "scene.json: /lights/1/type: a scene has at most one sky");
+  EXPECT_EQ(json_error(R"({)" + sphere + R"(, "lights": [{"type": "sky", "map": "none.exr"}]})")
+                .rfind("scene.json: /lights/0/map: ", 0),
+            0u);
   EXPECT_EQ(json_error(R"({"instances": [{"mesh": "bunny", "grid": {}}]})"),
             "scene.json: /instances/0/mesh: no mesh named 'bunny' (no meshes are defined)");
   EXPECT_EQ(json_error(R"({"a/b": 1})").rfind("scene.json: /a~1b: unknown key", 0), 0u);

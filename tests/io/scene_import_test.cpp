@@ -494,21 +494,22 @@ TEST(DefaultView, UpAloneFramesTheMeshAboutThatUp) {
 }
 
 /// One triangle with three KHR_lights_punctual lights: a point light, a directional light
-/// pointing down, a spot light (not supported).
+/// pointing down, a spot light pointing down from (1, 4, 0).
 constexpr const char* kLightsGltf = R"({
   "asset": {"version": "2.0"},
   "extensionsUsed": ["KHR_lights_punctual"],
   "extensions": {"KHR_lights_punctual": {"lights": [
     {"type": "point", "color": [1, 0.5, 0.25], "intensity": 20},
     {"type": "directional", "intensity": 3},
-    {"type": "spot", "intensity": 5, "spot": {}}]}},
+    {"type": "spot", "intensity": 5, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}}]}},
   "scenes": [{"nodes": [0, 1, 2, 3]}],
   "nodes": [
     {"mesh": 0},
     {"name": "bulb", "translation": [0, 2, 3], "extensions": {"KHR_lights_punctual": {"light": 0}}},
     {"name": "sun", "rotation": [-0.70710678, 0, 0, 0.70710678],
      "extensions": {"KHR_lights_punctual": {"light": 1}}},
-    {"name": "torch", "extensions": {"KHR_lights_punctual": {"light": 2}}}],
+    {"name": "torch", "translation": [1, 4, 0], "rotation": [-0.70710678, 0, 0, 0.70710678],
+     "extensions": {"KHR_lights_punctual": {"light": 2}}}],
   "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
   "buffers": [{"byteLength": 36,
     "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],
@@ -517,12 +518,12 @@ constexpr const char* kLightsGltf = R"({
                  "min": [0, 0, 0], "max": [1, 1, 0]}]
 })";
 
-TEST(GltfLights, PointAndDirectionalLightsInTheSceneUnits) {
+TEST(GltfLights, PointDirectionalAndSpotLightsInTheSceneUnits) {
   const fs::path p = scratch_dir() / "lights.gltf";
   write(p, kLightsGltf);
   const SceneDescription d = mesh_scene(p.string());
   EXPECT_FALSE(d.default_lights);
-  ASSERT_EQ(d.env.lights.size(), 2u);
+  ASSERT_EQ(d.env.lights.size(), 3u);
   const Light& point = d.env.lights[0];
   EXPECT_EQ(point.kind, LightKind::kPoint);
   EXPECT_EQ(point.position, (Vec3{0, 2, 3}));
@@ -532,10 +533,16 @@ TEST(GltfLights, PointAndDirectionalLightsInTheSceneUnits) {
   EXPECT_NEAR(sun.direction.y, -1.0f, 1e-6f);
   EXPECT_NEAR(std::fabs(sun.direction.z), 0.0f, 1e-6f);
   EXPECT_EQ(sun.intensity, (Vec3{3, 3, 3}));  // lux as irradiance
-  // The spot light: exactly one line, naming it; nothing about what is rendered.
-  ASSERT_EQ(d.warnings.size(), 1u);
-  EXPECT_NE(d.warnings[0].find("spot lights"), std::string::npos) << d.warnings[0];
-  EXPECT_NE(d.warnings[0].find("'torch'"), std::string::npos) << d.warnings[0];
+  // The spot light: at its node, along its node's -z (turned to point down), with glTF's
+  // half-angles from the axis.
+  const Light& spot = d.env.lights[2];
+  EXPECT_EQ(spot.kind, LightKind::kSpot);
+  EXPECT_EQ(spot.position, (Vec3{1, 4, 0}));
+  EXPECT_NEAR(spot.direction.y, -1.0f, 1e-6f);
+  EXPECT_EQ(spot.intensity, (Vec3{5, 5, 5}));
+  EXPECT_NEAR(spot.cos_inner, std::cos(0.2f), 1e-6f);
+  EXPECT_NEAR(spot.cos_outer, std::cos(0.5f), 1e-6f);
+  EXPECT_TRUE(d.warnings.empty()) << d.warnings[0];
 }
 
 TEST(GltfLights, SkinsAndAnimationsWarnOnceEach) {

@@ -228,7 +228,8 @@ void read_cameras_lights(const aiScene& scene, const std::string& path, bool glt
     const aiLight* l = scene.mLights[i];
     if (l == nullptr) continue;
     const std::string name = quoted(l->mName);
-    if (l->mType != aiLightSource_POINT && l->mType != aiLightSource_DIRECTIONAL) {
+    if (l->mType != aiLightSource_POINT && l->mType != aiLightSource_DIRECTIONAL &&
+        l->mType != aiLightSource_SPOT) {
       notes.add(std::string(light_kind(l->mType)) + " lights not supported, not used", name);
       continue;
     }
@@ -236,9 +237,17 @@ void read_cameras_lights(const aiScene& scene, const std::string& path, bool glt
     const aiMatrix4x4 g = node ? global_transform(node) : aiMatrix4x4();
     Light light;
     light.intensity = {l->mColorDiffuse.r, l->mColorDiffuse.g, l->mColorDiffuse.b};
-    if (l->mType == aiLightSource_POINT) {
-      light.kind = LightKind::kPoint;
+    if (l->mType == aiLightSource_POINT || l->mType == aiLightSource_SPOT) {
+      light.kind = l->mType == aiLightSource_SPOT ? LightKind::kSpot : LightKind::kPoint;
       light.position = point(g, l->mPosition);
+      if (l->mType == aiLightSource_SPOT) {
+        // Assimp's cone angles are glTF's: half-angles from the axis, in radians.
+        const Vec3 d = vector(g, l->mDirection);
+        light.direction = length(d) > 0.0f ? normalize(d) : Vec3{};
+        const float outer = std::clamp(l->mAngleOuterCone, 0.0f, 1.5707963f);
+        const float inner = std::clamp(l->mAngleInnerCone, 0.0f, outer);
+        light.cos_inner = std::cos(inner), light.cos_outer = std::cos(outer);
+      }
       if (l->mAttenuationConstant != 0.0f || l->mAttenuationLinear != 0.0f)
         notes.add("light falloff rendered as inverse-square instead of the file's, lights", name);
       if (node && node->mMetaData && node->mMetaData->HasKey("PBR_LightRange"))

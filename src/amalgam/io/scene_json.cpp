@@ -258,7 +258,9 @@ class SceneParser {
   // -- camera and lights ----------------------------------------------------------------------
 
   void read_lights(const JsonValue& v) {
-    for (const JsonValue& l : r_.items(v)) out_.env.lights.push_back(scene_json::read_light(r_, l));
+    scene_json::SkyInput sky{dir_, &out_.env.sky_map, &out_.inputs};
+    for (const JsonValue& l : r_.items(v))
+      out_.env.lights.push_back(scene_json::read_light(r_, l, sky));
   }
 
   // -- primitives -----------------------------------------------------------------------------

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "amalgam/io/image.h"
 #include "amalgam/io/scene_json.h"
 
 namespace amalgam::scene_json {
@@ -35,9 +36,44 @@ Camera read_camera(const JsonReader& r, const JsonValue& v) {
   return c;
 }
 
-Light read_light(const JsonReader& r, const JsonValue& l) {
+namespace {
+
+Light read_sky(const JsonReader& r, const JsonValue& l, SkyInput& sky) {
+  r.object(l, {"type", "radiance", "map", "rotate_y_deg", "samples"});
+  if (sky.seen) r.fail(l.ptr + "/type", "a scene has at most one sky");
+  sky.seen = true;
+  Light light;
+  light.kind = LightKind::kSky;
+  light.samples = 16;
+  if (auto x = r.find(l, "radiance")) light.intensity = r.colour(*x);
+  if (auto x = r.find(l, "samples")) light.samples = static_cast<int>(r.integer(*x, 1, 4096));
+  float rotate = 0.0f;
+  if (auto x = r.find(l, "rotate_y_deg")) rotate = static_cast<float>(r.number(*x, -360, 360));
+  if (auto m = r.find(l, "map")) {
+    const std::filesystem::path path = sky.dir / r.string(*m);
+    int w = 0, h = 0;
+    std::vector<Vec3> px;
+    try {
+      px = read_image(path.string(), w, h);
+    } catch (const std::exception& e) {
+      r.fail(m->ptr, e.what());
+    }
+    try {
+      *sky.map = std::make_shared<const SkyMap>(w, h, std::move(px), Vec3{1, 1, 1}, rotate);
+    } catch (const std::invalid_argument& e) {
+      r.fail(m->ptr, path.string() + ": " + e.what());
+    }
+    sky.inputs->push_back(path.string());
+  }
+  return light;
+}
+
+}  // namespace
+
+Light read_light(const JsonReader& r, const JsonValue& l, SkyInput& sky) {
   const std::string type = r.string(r.require(l, "type"));
   Light light;
+  if (type == "sky") return read_sky(r, l, sky);
   if (type == "point") {
     r.object(l, {"type", "position", "intensity", "radius", "samples"});
     light.kind = LightKind::kPoint;
@@ -50,8 +86,20 @@ Light read_light(const JsonReader& r, const JsonValue& l) {
     if (auto x = r.find(l, "angle"))
       light.angle = static_cast<float>(r.number(*x, 1e-4, 90.0, "in degrees, (0, 90]") *
                                        std::numbers::pi / 180.0);
+  } else if (type == "spot") {
+    r.object(l, {"type", "position", "direction", "intensity", "inner_deg", "outer_deg"});
+    light.kind = LightKind::kSpot;
+    light.position = r.vec3(r.require(l, "position"));
+    light.direction = normalize(r.direction(r.require(l, "direction")));
+    double outer = 45.0, inner = 0.0;
+    if (auto x = r.find(l, "outer_deg")) outer = r.number(*x, 1e-3, 90.0, "in degrees, (0, 90]");
+    if (auto x = r.find(l, "inner_deg"))
+      inner = r.number(*x, 0.0, outer, "in degrees, [0, outer_deg]");
+    light.cos_inner = static_cast<float>(std::cos(inner * std::numbers::pi / 180.0));
+    light.cos_outer = static_cast<float>(std::cos(outer * std::numbers::pi / 180.0));
   } else {
-    r.fail(l.ptr + "/type", "expected \"point\" or \"directional\", found \"" + type + "\"");
+    r.fail(l.ptr + "/type",
+           "expected \"point\", \"directional\", \"spot\" or \"sky\", found \"" + type + "\"");
   }
   light.intensity = r.colour(r.require(l, "intensity"));
   if (auto x = r.find(l, "samples")) {

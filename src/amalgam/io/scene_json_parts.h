@@ -4,7 +4,10 @@
 /// value and throws InputError naming the JSON pointer of what is wrong (JsonReader).
 
 #include <cstddef>
+#include <filesystem>
+#include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "amalgam/io/json_reader.h"
@@ -27,8 +30,18 @@ Surface read_surface(const JsonReader& r, const JsonValue& v);
 Camera read_camera(const JsonReader& r, const JsonValue& v);
 
 /// {"type": "point", "position", "intensity"} or {"type": "directional", "direction",
-/// "intensity"} (the direction normalised).
-Light read_light(const JsonReader& r, const JsonValue& v);
+/// "intensity"} (the direction normalised), {"type": "spot", "position", "direction",
+/// "intensity", "inner_deg"?, "outer_deg"?} (half-angles of glTF's falloff, default 0 and 45),
+/// or {"type": "sky", "radiance"?, "map"?, "rotate_y_deg"?, "samples"?}: at most one sky; its
+/// equirectangular map (.exr, .pfm or .png, scene/sky.h) is read relative to `sky.dir` into
+/// `sky.map`, its path added to `sky.inputs`.
+struct SkyInput {
+  std::filesystem::path dir;
+  std::shared_ptr<const SkyMap>* map = nullptr;
+  std::vector<std::string>* inputs = nullptr;
+  bool seen = false;
+};
+Light read_light(const JsonReader& r, const JsonValue& v, SkyInput& sky);
 
 /// The geometry of {"centre" (or "center"), "radius", "material"}, {"min", "max", "material"}
 /// or {"vertices", "material"} (a triangle of non-zero area); the material is left 0 for the

@@ -63,7 +63,7 @@ class Integrator {
         through *= 1.0f - a.opacity;
       }
     }
-    Vec3 end = env_.background;
+    Vec3 end = env_.seen_toward(primary.dir);
     if (hit.kind == TraceHit::Kind::kPrimitive) {
       const Surface surf = surface_at(h_, hit.id, hit.surf);
       const Vec3 n = surface_normal(h_, hit.id, hit.surf, wo);
@@ -169,7 +169,7 @@ class Integrator {
       r.normal += amalgam_normal(app, hit.surf, wo) * through;
       r.albedo += app.surface.colour * through;
     } else {
-      r.colour += env_.background * through;
+      r.colour += env_.seen_toward(primary.dir) * through;
     }
     auto lum = [](Vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; };
     float total = 0.0f;
@@ -243,20 +243,14 @@ class Integrator {
       const std::uint64_t light_key = hash_combine(key, (std::uint64_t{1} << 62) | light_index++);
       for (int k = 0; k < samples; ++k) {
         LightSample ls;
+        float u1 = 0.0f, u2 = 0.0f;
         if (light.sized()) {
           Sampler u(hash_combine(light_key, static_cast<std::uint64_t>(k)));
-          const float u1 = u.next(), u2 = u.next();
-          if (!sample_sized_light(light, origin, u1, u2, samples, ls)) break;
-        } else if (light.kind == LightKind::kPoint) {
-          const Vec3 d = light.position - origin;
-          ls.dist = length(d);
-          if (!(ls.dist > 0.0f)) continue;
-          ls.wi = d / ls.dist;
-          ls.e = light.intensity / (ls.dist * ls.dist);
-        } else {
-          ls.wi = -normalize(light.direction);
-          ls.dist = kInfinity;
-          ls.e = light.intensity;
+          u1 = u.next(), u2 = u.next();
+        }
+        if (!sample_light(light, env_.sky_map.get(), origin, n_shade, samples, u1, u2, ls)) {
+          if (light.kind == LightKind::kPoint && light.sized()) break;  // inside the sphere
+          continue;
         }
         sum += one_shadow_ray<kBaked, kShadows>(primary, s, n_shade, surf, key, stream, amalgam,
                                                 cloud, light, ls, origin, wo);
@@ -285,7 +279,7 @@ class Integrator {
         const auto exit = intersect_solid_box(Ray::make(s.p + wi * reach, -wi), box);
         if (!exit) return {};
         from = offset_ray_origin(exit->p, exit->p_error, exit->normal);
-        if (light.kind == LightKind::kPoint) {
+        if (is_positional(light)) {
           if (light.sized()) {
             dist = to_sphere(from, wi, light.position, light.radius);
             if (!(dist > 0.0f)) return {};  // the light is inside the box
@@ -308,7 +302,7 @@ class Integrator {
       // occluders render as amalgams although their shadows span many pixels.) Toward a sized
       // light the beam ends as wide as its share of the light (render/lights.h).
       shadow.cone_width = primary.footprint(s.t);
-      if (light.kind == LightKind::kPoint)
+      if (is_positional(light))
         shadow.cone_spread = (ls.end_width - shadow.cone_width) / std::max(dist, 1e-30f);
       else
         shadow.cone_spread = ls.spread;

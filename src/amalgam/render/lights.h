@@ -19,6 +19,7 @@
 
 #include "amalgam/geometry/ray.h"
 #include "amalgam/scene/scene.h"
+#include "amalgam/scene/sky.h"
 #include "amalgam/util/isa.h"
 
 namespace amalgam {
@@ -86,6 +87,85 @@ inline bool sample_sized_light(const Light& l, Vec3 p, float u1, float u2, int n
   const float radiance_scale = 1.0f / (pi * l.radius * l.radius);
   s.e = l.intensity * (radiance_scale * 2.0f * pi * (1.0f - cos_max) * share);
   s.end_width = 2.0f * l.radius * root;
+  return true;
+}
+
+/// Point and spot lights: at a position, their light falling off with the square distance.
+inline bool is_positional(const Light& l) {
+  return l.kind == LightKind::kPoint || l.kind == LightKind::kSpot;
+}
+
+/// A spot light's share of its axial intensity toward unit `wi` (from the shaded point toward
+/// the light): glTF's falloff, ((cos - cos_outer) / (cos_inner - cos_outer))^2 in [0, 1].
+inline float spot_falloff(const Light& l, Vec3 wi) {
+  const float c = -dot(wi, l.direction);
+  if (!(l.cos_inner > l.cos_outer)) return c >= l.cos_outer ? 1.0f : 0.0f;
+  const float t = std::clamp((c - l.cos_outer) / (l.cos_inner - l.cos_outer), 0.0f, 1.0f);
+  return t * t;
+}
+
+/// Sample (u1, u2) of the sky `l` (scene/scene.h), one of `n`, seen from a point with unit
+/// shading normal `normal` (or the zero vector: no preferred side). With a map: a direction
+/// drawn by the map's luminance (scene/sky.h); without, a constant radiance: cosine-weighted
+/// about the normal (uniform over the sphere without one). The sample carries radiance /
+/// (density x n), so that brdf x e x cos sums to the irradiance-weighted estimate. Its cone
+/// spreads as wide as its share of the hemisphere.
+inline bool sample_sky(const Light& l, const SkyMap* map, Vec3 normal, float u1, float u2, int n,
+                       LightSample& s) {
+  constexpr float pi = std::numbers::pi_v<float>;
+  const float share = 1.0f / static_cast<float>(std::max(n, 1));
+  s.dist = kInfinity;
+  const float cos_half = std::max(-1.0f, 1.0f - 2.0f * share);  // a cap of 2 pi / n sr
+  s.spread =
+      2.0f * std::sqrt(std::max(0.0f, 1.0f - cos_half * cos_half)) / std::max(cos_half, 1e-3f);
+  if (map != nullptr) {
+    const SkyMap::Sample m = map->sample(u1, u2);
+    if (!(m.pdf > 0.0f)) return false;
+    s.wi = m.dir;
+    s.e = l.intensity * m.radiance * (share / m.pdf);
+    return true;
+  }
+  if (normal == Vec3{}) {  // uniform over the sphere: density 1 / (4 pi)
+    const float z = 1.0f - 2.0f * u1, r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    const float phi = 2.0f * pi * u2;
+    s.wi = {r * std::cos(phi), z, r * std::sin(phi)};
+    s.e = l.intensity * (4.0f * pi * share);
+    return true;
+  }
+  // Cosine-weighted: density cos / pi, so radiance x pi / (cos n).
+  const float r = std::sqrt(u1), phi = 2.0f * pi * u2;
+  const float c = std::sqrt(std::max(0.0f, 1.0f - u1));
+  if (!(c > 0.0f)) return false;
+  Vec3 a, b;
+  basis(normal, a, b);
+  s.wi = normalize(a * (r * std::cos(phi)) + b * (r * std::sin(phi)) + normal * c);
+  s.e = l.intensity * (pi * share / c);
+  return true;
+}
+
+/// One light sample seen from `p` (shading normal `normal`, used by the sky only): sized
+/// lights and the sky from (u1, u2), one of `n`; a point, spot or directional light without
+/// size exactly (u1, u2 unused). False when it brings nothing.
+inline bool sample_light(const Light& l, const SkyMap* map, Vec3 p, Vec3 normal, int n, float u1,
+                         float u2, LightSample& s) {
+  if (l.kind == LightKind::kSky) return sample_sky(l, map, normal, u1, u2, n, s);
+  if (l.sized()) return sample_sized_light(l, p, u1, u2, n, s);
+  if (is_positional(l)) {
+    const Vec3 d = l.position - p;
+    s.dist = length(d);
+    if (!(s.dist > 0.0f)) return false;
+    s.wi = d / s.dist;
+    s.e = l.intensity / (s.dist * s.dist);
+    if (l.kind == LightKind::kSpot) {
+      const float f = spot_falloff(l, s.wi);
+      if (!(f > 0.0f)) return false;
+      s.e = s.e * f;
+    }
+    return true;
+  }
+  s.wi = -normalize(l.direction);
+  s.dist = kInfinity;
+  s.e = l.intensity;
   return true;
 }
 

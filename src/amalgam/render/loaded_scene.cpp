@@ -87,6 +87,12 @@ std::uint64_t content_hash(const LoadedScene& scene) {
       h.add(l.radius), h.add(l.angle);
       h.add(static_cast<std::uint64_t>(l.samples));
     }
+    if (l.kind == LightKind::kSpot) h.add(l.cos_inner), h.add(l.cos_outer);
+  }
+  if (const SkyMap* m = scene.env.sky_map.get()) {
+    h.add(static_cast<std::uint64_t>(m->width())), h.add(static_cast<std::uint64_t>(m->height()));
+    h.add(m->rotate_y_deg());
+    for (const Vec3& p : m->pixels()) h.add(p);
   }
   const Camera& c = scene.env.camera;
   h.add(c.position), h.add(c.look_at), h.add(c.up), h.add(c.vfov_deg);

@@ -92,7 +92,7 @@ class VolumeIntegrator final : private DeferSink {
       r.normal += surface_normal(h_, hit.id, hit.surf, wo) * through;
       r.albedo += end_surface.colour * through;
     } else if (through > 0.0f) {
-      r.colour += env_.background * through;
+      r.colour += env_.seen_toward(primary.dir) * through;
     }
     float amalgam_weight = 0.0f;
     for (const Member& m : members_) {
@@ -331,21 +331,11 @@ class VolumeIntegrator final : private DeferSink {
   }
 
   /// The light sample (u1, u2) of `light` seen from `p`; false if it brings nothing.
-  static bool light_sample(const Light& light, Vec3 p, int samples, float u1, float u2,
-                           LightSample& ls) {
-    if (light.sized()) return sample_sized_light(light, p, u1, u2, samples, ls);
-    if (light.kind == LightKind::kPoint) {
-      const Vec3 d = light.position - p;
-      ls.dist = length(d);
-      if (!(ls.dist > 0.0f)) return false;
-      ls.wi = d / ls.dist;
-      ls.e = light.intensity / (ls.dist * ls.dist);
-      return true;
-    }
-    ls.wi = -normalize(light.direction);
-    ls.dist = kInfinity;
-    ls.e = light.intensity;
-    return true;
+  /// (No shading normal: a cell's facets face every way, so the sky is sampled over the whole
+  /// sphere; the surface hit takes its normal's hemisphere.)
+  bool light_sample(const Light& light, Vec3 p, Vec3 normal, int samples, float u1, float u2,
+                    LightSample& ls) const {
+    return sample_light(light, env_.sky_map.get(), p, normal, samples, u1, u2, ls);
   }
 
   /// One light sample: each member's unshadowed radiance, one shadow query from a member drawn
@@ -359,7 +349,7 @@ class VolumeIntegrator final : private DeferSink {
       const Segment& s = segs_[static_cast<std::size_t>(m.seg)];
       const Vec3 p = primary.at(m.t);
       LightSample ls;
-      if (!light_sample(light, p, samples, u1, u2, ls)) continue;
+      if (!light_sample(light, p, Vec3{}, samples, u1, u2, ls)) continue;
       const Vec3 u = cell_radiance(objects_[s.obj], s.cell, ls.wi, ls.e);
       if (luminance(u) > 0.0f) lits_.push_back({u, p, ls, m.w, m.seg});
     }
@@ -367,8 +357,8 @@ class VolumeIntegrator final : private DeferSink {
       const SurfaceHit& sh = hit.surf;
       const Vec3 origin = offset_ray_origin(sh.p, sh.p_error, sh.normal);
       LightSample ls;
-      if (light_sample(light, origin, samples, u1, u2, ls)) {
-        const Vec3 n = surface_normal(h_, hit.id, sh, wo);
+      const Vec3 n = surface_normal(h_, hit.id, sh, wo);
+      if (light_sample(light, origin, n, samples, u1, u2, ls)) {
         const float f_cos = dot(n, ls.wi);
         if (f_cos > 0.0f && dot(sh.normal, ls.wi) > 0.0f) {
           const Vec3 u = brdf(end_surface, n, ls.wi, wo) * ls.e * f_cos;
@@ -390,7 +380,7 @@ class VolumeIntegrator final : private DeferSink {
     const bool from_cell = c.seg >= 0;
     const float t_from = from_cell ? members_t(c.seg) : hit.t;
     shadow.cone_width = primary.footprint(t_from);
-    if (light.kind == LightKind::kPoint)
+    if (is_positional(light))
       shadow.cone_spread = (c.ls.end_width - shadow.cone_width) / std::max(c.ls.dist, 1e-30f);
     else
       shadow.cone_spread = c.ls.spread;

@@ -51,4 +51,14 @@ Ray Camera::generate(float fx, float fy, int width, int height) const {
   return r;
 }
 
+Vec3 Environment::seen_toward(Vec3 dir) const {
+  for (const Light& l : lights)
+    if (l.kind == LightKind::kSky) {
+      if (!sky_map) return l.intensity;
+      const Vec3 m = sky_map->radiance(dir);
+      return {l.intensity.x * m.x, l.intensity.y * m.y, l.intensity.z * m.z};
+    }
+  return background;
+}
+
 }  // namespace amalgam

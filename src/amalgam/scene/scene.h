@@ -2,6 +2,7 @@
 /// \file What a user describes: surfaces, primitives, lights, camera.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -9,6 +10,7 @@
 #include "amalgam/geometry/bbox.h"
 #include "amalgam/geometry/intersect.h"
 #include "amalgam/math/transform.h"
+#include "amalgam/scene/sky.h"
 
 namespace amalgam {
 
@@ -48,7 +50,7 @@ std::optional<SurfaceHit> intersect(const Primitive& prim, const Ray& ray);
 /// Tight bounds of a primitive.
 Bbox bounds(const Primitive& prim);
 
-enum class LightKind : std::uint8_t { kPoint, kDirectional };
+enum class LightKind : std::uint8_t { kPoint, kDirectional, kSpot, kSky };
 
 /// A point light (position, intensity in W/sr) or a directional light (direction the light
 /// travels, irradiance). Either may have a size, which makes its shadows soft (render/lights.h):
@@ -57,6 +59,15 @@ enum class LightKind : std::uint8_t { kPoint, kDirectional };
 /// `angle` > 0 comes from a disc of that angular diameter (radians) about -direction, the
 /// same irradiance in all. A sized light is sampled with `samples` shadow rays per shading
 /// point. Lights are not visible to camera rays.
+///
+/// A spot light (glTF's KHR_lights_punctual) is a point light shining along `direction` with
+/// `intensity` on its axis, scaled off the axis by the glTF falloff: ((cos - cos_outer) /
+/// (cos_inner - cos_outer))^2 clamped to [0, 1], cos being that of the angle to the axis.
+///
+/// The sky (at most one) lights from every direction at infinity: radiance `intensity`, times
+/// Environment::sky_map in that direction when there is one (scene/sky.h). It is sampled with
+/// `samples` shadow rays per shading point (render/lights.h) and seen by camera rays that miss
+/// everything (in place of Environment::background).
 struct Light {
   LightKind kind = LightKind::kPoint;
   Vec3 position{};
@@ -65,8 +76,21 @@ struct Light {
   float radius = 0.0f;  ///< point lights: sphere radius (0: a point)
   float angle = 0.0f;   ///< directional lights: angular diameter in radians (0: one direction)
   int samples = 1;      ///< shadow rays per shading point when the light has a size
+  float cos_inner = 1.0f, cos_outer = 0.0f;  ///< spot lights: the falloff's cone
 
-  bool sized() const { return kind == LightKind::kPoint ? radius > 0.0f : angle > 0.0f; }
+  bool sized() const {
+    switch (kind) {
+      case LightKind::kPoint:
+        return radius > 0.0f;
+      case LightKind::kDirectional:
+        return angle > 0.0f;
+      case LightKind::kSpot:
+        return false;
+      case LightKind::kSky:
+        return true;
+    }
+    return false;
+  }
 };
 
 /// A pinhole camera.
@@ -96,6 +120,12 @@ struct Environment {
   std::vector<Light> lights;
   Camera camera;
   Vec3 background{0.05f, 0.05f, 0.08f};
+  /// The sky light's radiance map, if it has one (scene/sky.h).
+  std::shared_ptr<const SkyMap> sky_map;
+
+  /// What a camera ray that meets nothing sees along unit `dir`: the sky when there is one,
+  /// else the background.
+  Vec3 seen_toward(Vec3 dir) const;
 };
 
 }  // namespace amalgam
