@@ -23,7 +23,9 @@ Usage:
 Groups: demo (the four renders of scripts/demo.sh: 480x360, 4 spp, about 10 s),
 experiments (the names `amalgam experiment` takes), counts (the README's exact counts: a line
 traced, prisms rendered, about 5 s), embree (the pixels where --tracer embree differs from the
-traditional renderer; needs a build with Embree), pyexample (examples/quality_vs_cost.py
+traditional renderer; needs a build with Embree), advise (`amalgam advise` on the field's
+street and aerial views and the meadow: timings only, so `update --only advise` writes them
+and `check` never compares them; about 4 minutes), pyexample (examples/quality_vs_cost.py
 through the Python module, build/python or $AMALGAM_PYTHON; about 3 s), qvc (scripts/quality-vs-cost.sh, about
 40 s; its generated table is compared too, timing columns left out).
 """
@@ -207,6 +209,33 @@ def embree_values(amalgam, tmp):
     return v
 
 
+# --- advise: `amalgam advise` on three views (timings: written by update, never compared) -----
+
+ADVISE_VIEWS = {
+    "street": ["scenes/field.json"],
+    "aerial": ["scenes/field.json", "--eye", "0,260,420", "--look-at", "0,0,0", "--fov", "40"],
+    "meadow": ["scenes/meadow.json"],
+}
+
+
+def advise_values(amalgam, tmp):
+    import datetime
+    import platform
+    v = {}
+    for view, args in ADVISE_VIEWS.items():
+        args = [str(ROOT / args[0])] + args[1:]
+        out = subprocess.run([amalgam, "advise", *args, "--json", "-"], check=True,
+                             capture_output=True, text=True).stdout
+        j = json.loads(out)
+        for r in j["renderers"]:
+            v[f"advise.{view}.{r['key']}"] = f"{r['vs_full_detail']:.2f}x"
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
+                            capture_output=True, text=True).stdout.strip() or "unknown"
+    v["advise.stamp"] = (f"{platform.node()}, {os.cpu_count()} cores, "
+                         f"{datetime.date.today().isoformat()}, commit {commit}")
+    return v
+
+
 # --- pyexample: examples/quality_vs_cost.py (the Python module) ------------------------------
 
 def pyexample_values(amalgam, tmp):
@@ -283,6 +312,8 @@ def measure(groups, amalgam, tmp, demo_dir=None, qvc_dir=None):
         values.update(pyexample_values(amalgam, tmp))
     if "counts" in groups:
         values.update(counts_values(amalgam, tmp))
+    if "advise" in groups:
+        values.update(advise_values(amalgam, tmp))
     if "embree" in groups:
         values.update(embree_values(amalgam, tmp))
     if "qvc" in groups:
@@ -311,7 +342,7 @@ def main():
         return 0
 
     groups = set(a.only.split(","))
-    known = {"demo", "experiments", "counts", "embree", "pyexample", "qvc"}
+    known = {"demo", "experiments", "counts", "embree", "advise", "pyexample", "qvc"}
     if not groups <= known:
         sys.exit(f"figures.py: unknown group {sorted(groups - known)}; known: {sorted(known)}")
     with tempfile.TemporaryDirectory() as tmp:
