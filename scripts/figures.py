@@ -23,7 +23,10 @@ Usage:
 Groups: demo (the four renders of scripts/demo.sh: 480x360, 4 spp, about 10 s),
 experiments (the names `amalgam experiment` takes), counts (the README's exact counts: a line
 traced, prisms rendered, about 5 s), embree (the pixels where --tracer embree differs from the
-traditional renderer; needs a build with Embree), advise (`amalgam advise` on the field's
+traditional renderer; needs a build with Embree), field (docs/real-scenes.md: scenes/field.json
+at 1024x768 and its far band at 512x384; about 20 s; update also rewrites docs/img/field.png),
+paper (the verdict counts of docs/paper-reproduction.md, which
+scripts/plots/regenerate-docs.sh writes from `amalgam experiment all`), advise (`amalgam advise` on the field's
 street and aerial views and the meadow: timings only, so `update --only advise` writes them
 and `check` never compares them; about 4 minutes), pyexample (examples/quality_vs_cost.py
 through the Python module, build/python or $AMALGAM_PYTHON; about 3 s), qvc (scripts/quality-vs-cost.sh, about
@@ -209,6 +212,94 @@ def embree_values(amalgam, tmp):
     return v
 
 
+# --- paper: the verdicts of docs/paper-reproduction.md (written by regenerate-docs.sh) -------
+
+def paper_values():
+    """The README's summary of the report's verdict table: counts and the statements of each
+    verdict other than "holds"."""
+    rows, inside = [], False
+    for line in (ROOT / "docs/paper-reproduction.md").read_text().splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if line.startswith("| statement | the paper says | verdict"):
+            inside = True
+        elif inside and not line.startswith("|"):
+            break
+        elif inside and not set(cells[0]) <= set("-"):
+            rows.append((cells[0], cells[2]))
+    kinds = {"holds": [], "holds with correction": [], "does not hold": []}
+    other = []
+    for name, verdict in rows:
+        (kinds[verdict] if verdict in kinds else other).append(f"{name} ({verdict})"
+                                                              if verdict not in kinds else name)
+    v = {"paper.count": str(len(rows)), "paper.holds": str(len(kinds["holds"])),
+         "paper.correction": str(len(kinds["holds with correction"])),
+         "paper.not": str(len(kinds["does not hold"])), "paper.other": str(len(other))}
+    v["paper.list.correction"] = "; ".join(kinds["holds with correction"]) or "none"
+    v["paper.list.not"] = "; ".join(kinds["does not hold"]) or "none"
+    v["paper.list.other"] = "; ".join(other) or "none"
+    return v
+
+
+# --- field: docs/real-scenes.md (scenes/field.json at 1024x768 and its far band) -----------
+
+FIELD_RUNS = [("ss4", ["--footprint", "1", "--spp", "4"]), ("ss1", ["--footprint", "1", "--spp", "1"]),
+              ("trad1", ["--renderer", "traditional", "--spp", "1"]),
+              ("trad4", ["--renderer", "traditional", "--spp", "4"])]
+
+
+def field_values(amalgam, tmp, image_out=None):
+    import numpy as np
+    import pfm
+    field = str(ROOT / "scenes/field.json")
+    v, st = {}, {}
+    for name, args in FIELD_RUNS:
+        out = tmp / f"field-{name}.pfm"
+        st[name] = json.loads(subprocess.run(
+            [amalgam, "render", field, "--width", "1024", "--height", "768", "--threads", "2",
+             *args, "--out", str(out), "--stats", "-", "--quiet"], check=True,
+            capture_output=True, text=True).stdout)
+        t, p = st[name]["time_s"], st[name]["per_primary_ray"]
+        v[f"field.{name}.setup"] = f"{t['load']:.2f} + {t['build'] + t['bake']:.2f}"
+        v[f"field.{name}.render"] = f"{t['render']:.2f}"
+        v[f"field.{name}.tests"] = f"{p['mean']:.1f} / {p['p50']:g} / {p['p99']:g}"
+        v[f"field.{name}.primitive"] = f"{st[name]['tests']['primitive'] / 1e6:.2f} M"
+        v[f"field.{name}.memory"] = f"{st[name]['peak_memory_bytes'] / 1e6:.0f}"
+    sc = st["ss4"]["scene"]
+    v["field.triangles"] = f"{sc['primitives']:,}"
+    v["field.nodes"] = f"{sc['nodes'] / 1e6:.0f} million"
+    v["field.levels"] = str(sc["levels"])
+    c = json.loads(subprocess.run([amalgam, "compare", str(tmp / "field-ss4.pfm"),
+                                   str(tmp / "field-trad4.pfm"), "--json"], check=True,
+                                  capture_output=True, text=True).stdout)
+    v["field.cmp.rmse"], v["field.cmp.psnr"], v["field.cmp.ssim"] = (
+        f"{c['rmse']:.4f}", f"{c['psnr_db']:.1f}", f"{c['ssim']:.3f}")
+    a, b = st["ss4"]["tests"], st["trad4"]["tests"]
+    v["field.fewer.primitive"] = f"{100 * (1 - a['primitive'] / b['primitive']):.0f} %"
+    v["field.fewer.total"] = f"{100 * (1 - a['total'] / b['total']):.0f} %"
+    if image_out:
+        subprocess.run([amalgam, "render", field, "--width", "1024", "--height", "768",
+                        "--footprint", "1", "--spp", "4", "--out", str(image_out), "--quiet"],
+                       check=True)
+    # The far band (rows 174-214 of 512x384: ground and Wusons just below the horizon), 4 spp,
+    # against the traditional renderer at 32 spp with a seed of its own.
+    band = {}
+    for name, args in [("trad", ["--renderer", "traditional", "--spp", "4"]),
+                       ("ss", ["--footprint", "1", "--spp", "4"]),
+                       ("ss-k4", ["--footprint", "4", "--spp", "4"]),
+                       ("ref", ["--renderer", "traditional", "--spp", "32", "--seed", "9001"])]:
+        out = tmp / f"band-{name}.pfm"
+        subprocess.run([amalgam, "render", field, "--width", "512", "--height", "384", *args,
+                        "--out", str(out), "--quiet"], check=True)
+        band[name] = pfm.read_pfm(out).astype(np.float64)
+    lum = np.array([0.2126, 0.7152, 0.0722])
+    for name in ("trad", "ss", "ref"):
+        v[f"field.band.{name}"] = f"{float((band[name][174:214] @ lum).mean()):.3f}"
+    for name in ("trad", "ss", "ss-k4"):
+        rmse = float(np.sqrt(np.mean((band[name] - band["ref"]) ** 2)))
+        v[f"field.band.rmse.{name}"] = f"{rmse:.4f}"
+    return v
+
+
 # --- advise: `amalgam advise` on three views (timings: written by update, never compared) -----
 
 ADVISE_VIEWS = {
@@ -298,7 +389,7 @@ def mask_timing_columns(text):
 
 # --- check / update ---------------------------------------------------------------------------
 
-def measure(groups, amalgam, tmp, demo_dir=None, qvc_dir=None):
+def measure(groups, amalgam, tmp, demo_dir=None, qvc_dir=None, update_images=False):
     """Every figure of the groups, measured (or read from the given directories)."""
     values, qvc_doc = {}, None
     if "demo" in groups:
@@ -314,6 +405,11 @@ def measure(groups, amalgam, tmp, demo_dir=None, qvc_dir=None):
         values.update(counts_values(amalgam, tmp))
     if "advise" in groups:
         values.update(advise_values(amalgam, tmp))
+    if "paper" in groups:
+        values.update(paper_values())
+    if "field" in groups:
+        values.update(field_values(amalgam, tmp,
+                                   ROOT / "docs/img/field.png" if update_images else None))
     if "embree" in groups:
         values.update(embree_values(amalgam, tmp))
     if "qvc" in groups:
@@ -330,7 +426,7 @@ def main():
     ap.add_argument("mode", choices=["check", "update", "fill"])
     ap.add_argument("file", nargs="?")
     ap.add_argument("--amalgam", default=os.environ.get("AMALGAM", str(ROOT / "build/amalgam")))
-    ap.add_argument("--only", default="demo,experiments,counts,embree,pyexample,qvc")
+    ap.add_argument("--only", default="demo,experiments,counts,embree,field,paper,pyexample,qvc")
     ap.add_argument("--demo-dir")
     ap.add_argument("--qvc-dir")
     ap.add_argument("--qvc-csv")
@@ -342,11 +438,13 @@ def main():
         return 0
 
     groups = set(a.only.split(","))
-    known = {"demo", "experiments", "counts", "embree", "advise", "pyexample", "qvc"}
+    known = {"demo", "experiments", "counts", "embree", "field", "paper", "advise", "pyexample",
+             "qvc"}
     if not groups <= known:
         sys.exit(f"figures.py: unknown group {sorted(groups - known)}; known: {sorted(known)}")
     with tempfile.TemporaryDirectory() as tmp:
-        values, qvc_doc = measure(groups, a.amalgam, Path(tmp), a.demo_dir, a.qvc_dir)
+        values, qvc_doc = measure(groups, a.amalgam, Path(tmp), a.demo_dir, a.qvc_dir,
+                                  update_images=a.mode == "update")
         qvc_fresh = (fill_text(qvc_doc.read_text(), values) if qvc_doc else None)
     problems, checked = [], 0
     for page in pages():
