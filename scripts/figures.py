@@ -26,7 +26,10 @@ traced, prisms rendered, about 5 s), embree (the pixels where --tracer embree di
 traditional renderer; needs a build with Embree), field (docs/real-scenes.md: scenes/field.json
 at 1024x768 and its far band at 512x384; about 20 s; update also rewrites docs/img/field.png),
 paper (the verdict counts of docs/paper-reproduction.md, which
-scripts/plots/regenerate-docs.sh writes from `amalgam experiment all`), advise (`amalgam advise` on the field's
+scripts/plots/regenerate-docs.sh writes from `amalgam experiment all`), yardstick (the
+README's summary of the pages scripts/yardstick.sh writes: best speed-ups and commits), stamps
+(each hand-written reading of a generated run names that run's commit or date: regenerating
+the run without rewriting its reading fails the check), advise (`amalgam advise` on the field's
 street and aerial views and the meadow: timings only, so `update --only advise` writes them
 and `check` never compares them; about 4 minutes), pyexample (examples/quality_vs_cost.py
 through the Python module, build/python or $AMALGAM_PYTHON; about 3 s), qvc (scripts/quality-vs-cost.sh, about
@@ -240,6 +243,59 @@ def paper_values():
     return v
 
 
+# --- yardstick: the README's summary of the yardstick pages (written by yardstick.sh) -------
+
+YARDSTICK_PAGES = {"meadow": ("docs/yardstick-meadow.md", "street"),
+                   "soft": ("docs/yardstick-soft.md", "aerial"),
+                   "aerial": ("docs/yardstick.md", "aerial"),
+                   "street": ("docs/yardstick.md", "street")}
+
+
+def yardstick_values():
+    """Per page and view: the scale-sensitive curve with the largest speed-up over the
+    traditional renderer at equal error, its speed-up, its ratio to Embree, and the page's
+    commit; "never" when no scale-sensitive curve reaches that error."""
+    v = {}
+    for key, (page, view) in YARDSTICK_PAGES.items():
+        text = (ROOT / page).read_text()
+        v[f"yardstick.{key}.commit"] = re.search(r"` at commit ([0-9a-f]+)\.", text).group(1)
+        section = text[text.index(f"### {view} view"):]
+        best = None
+        for line in section[section.index("| curve |"):].splitlines()[2:]:
+            if not line.startswith("|"):
+                break
+            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            if cells[0].startswith("scale-sensitive") and cells[2] != "-":
+                speed = float(cells[2].rstrip("x"))
+                if best is None or speed > best[1]:
+                    best = (cells[0], speed, cells[4])
+        if best is None:
+            v[f"yardstick.{key}.best"] = "never reaches that error (bias)"
+            v[f"yardstick.{key}.embree"] = "-"
+        else:
+            v[f"yardstick.{key}.best"] = f"{best[1]:.2f}x ({best[0]})"
+            v[f"yardstick.{key}.embree"] = best[2]
+    return v
+
+
+# --- stamps: a hand-written reading names the run it reads --------------------------------
+
+def stamp_values():
+    """The commit or date of each generated run that a hand-written reading comments on. A
+    reading carries the stamp of the run it was written from; when the run is regenerated,
+    the stamps differ and `check` says the reading must be rewritten."""
+    v = {}
+    for key, page in (("yardstick", "docs/yardstick.md"),
+                      ("yardstick-meadow", "docs/yardstick-meadow.md"),
+                      ("yardstick-soft", "docs/yardstick-soft.md")):
+        text = (ROOT / page).read_text()
+        v[f"stamps.{key}"] = re.search(r"` at commit ([0-9a-f]+)\.", text).group(1)
+    readme = (ROOT / "README.md").read_text()
+    block = readme[readme.index("<!-- bench:begin"):readme.index("<!-- bench:end")]
+    v["stamps.bench"] = re.search(r"date (\d{4}-\d\d-\d\d)", block).group(1)
+    return v
+
+
 # --- field: docs/real-scenes.md (scenes/field.json at 1024x768 and its far band) -----------
 
 FIELD_RUNS = [("ss4", ["--footprint", "1", "--spp", "4"]), ("ss1", ["--footprint", "1", "--spp", "1"]),
@@ -407,6 +463,10 @@ def measure(groups, amalgam, tmp, demo_dir=None, qvc_dir=None, update_images=Fal
         values.update(advise_values(amalgam, tmp))
     if "paper" in groups:
         values.update(paper_values())
+    if "yardstick" in groups:
+        values.update(yardstick_values())
+    if "stamps" in groups:
+        values.update(stamp_values())
     if "field" in groups:
         values.update(field_values(amalgam, tmp,
                                    ROOT / "docs/img/field.png" if update_images else None))
@@ -426,7 +486,7 @@ def main():
     ap.add_argument("mode", choices=["check", "update", "fill"])
     ap.add_argument("file", nargs="?")
     ap.add_argument("--amalgam", default=os.environ.get("AMALGAM", str(ROOT / "build/amalgam")))
-    ap.add_argument("--only", default="demo,experiments,counts,embree,field,paper,pyexample,qvc")
+    ap.add_argument("--only", default="demo,experiments,counts,embree,field,paper,yardstick,stamps,pyexample,qvc")
     ap.add_argument("--demo-dir")
     ap.add_argument("--qvc-dir")
     ap.add_argument("--qvc-csv")
@@ -438,8 +498,8 @@ def main():
         return 0
 
     groups = set(a.only.split(","))
-    known = {"demo", "experiments", "counts", "embree", "field", "paper", "advise", "pyexample",
-             "qvc"}
+    known = {"demo", "experiments", "counts", "embree", "field", "paper", "yardstick", "stamps",
+             "advise", "pyexample", "qvc"}
     if not groups <= known:
         sys.exit(f"figures.py: unknown group {sorted(groups - known)}; known: {sorted(known)}")
     with tempfile.TemporaryDirectory() as tmp:
