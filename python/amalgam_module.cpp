@@ -489,21 +489,23 @@ PYBIND11_MODULE(amalgam, m) {
       "  amalgam.compare(r, reference)                    # rmse, psnr_db, ssim, ...\n"
       "  amalgam.experiment('expected', quick=True)       # the table as a list of dicts\n\n"
       "Bad input raises ValueError, runtime failures RuntimeError, each with the CLI's\n"
-      "one-line message. See docs/python.md.";
+      "one-line message (a bug of amalgam's: RuntimeError 'internal error: ...'). See\n"
+      "docs/python.md.";
   m.attr("__version__") = version();
   m.attr("has_embree") = have_embree();  // tracer="embree" is available
 
+  // The CLI's classification (util/error.h, error_kind): bad input -> ValueError (exit 2),
+  // a failed run and a bug of ours -> RuntimeError (exit 1). Other exceptions (out of memory,
+  // Python's own from a callback) keep pybind11's translation.
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const InputError& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
-    } catch (const MetricsError& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
     } catch (const RuntimeError& e) {
       PyErr_SetString(PyExc_RuntimeError, e.what());
-    } catch (const InternalError& e) {
-      PyErr_SetString(PyExc_RuntimeError, e.what());
+    } catch (const std::logic_error& e) {  // InternalError and every other logic_error
+      PyErr_SetString(PyExc_RuntimeError, (std::string("internal error: ") + e.what()).c_str());
     }
   });
 

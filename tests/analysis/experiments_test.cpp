@@ -80,7 +80,7 @@ void expect_checks_pass(const ExperimentResult& r) {
 
 TEST(Experiments, NamesAreTheNineOfIssue3AndTraversed) {
   EXPECT_EQ(names().size(), 14u);
-  EXPECT_THROW(run("no-such-experiment", Config{}), std::invalid_argument);
+  EXPECT_THROW(run("no-such-experiment", Config{}), InputError);
 }
 
 TEST(Experiments, WorstTraditionalIsExactlyCt0) {

@@ -135,7 +135,7 @@ TEST(Sky, MapDensityIsNormalisedAndMatchesItsSamples) {
     EXPECT_NEAR(s.pdf, m.pdf(s.dir), 1e-3f * s.pdf) << i;
     EXPECT_EQ(s.radiance, m.radiance(s.dir)) << i;
   }
-  EXPECT_THROW(SkyMap(2, 2, std::vector<Vec3>(4), {1, 1, 1}), std::invalid_argument);
+  EXPECT_THROW(SkyMap(2, 2, std::vector<Vec3>(4), {1, 1, 1}), InputError);
 }
 
 TEST(Spot, FalloffIsGltfs) {

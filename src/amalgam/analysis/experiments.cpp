@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "amalgam/util/error.h"
+
 namespace amalgam::experiments {
 
 std::size_t Table::col(const std::string& name) const {
@@ -101,7 +103,7 @@ ExperimentResult run(const std::string& name, const Config& config) {
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return r;
   }
-  throw std::invalid_argument("unknown experiment '" + name + "'");
+  throw InputError("unknown experiment '" + name + "'");
 }
 
 LinearFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {

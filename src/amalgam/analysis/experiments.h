@@ -162,7 +162,7 @@ double predict(const Config& config, const std::string& name, double value);
 /// The nine experiment names in report order.
 const std::vector<std::string>& names();
 
-/// Runs one experiment by name; throws std::invalid_argument for an unknown name.
+/// Runs one experiment by name; throws InputError for an unknown name.
 ExperimentResult run(const std::string& name, const Config& config);
 
 // The experiments, one function each (issue 3, items 1-9).

@@ -10,11 +10,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "amalgam/util/error.h"
+
 namespace amalgam::formulas {
 namespace {
 
 void require(bool ok, const char* what) {
-  if (!ok) throw std::invalid_argument(std::string("amalgam::formulas: ") + what);
+  if (!ok) throw InternalError(std::string("amalgam::formulas: ") + what);
 }
 
 std::uint64_t checked_add(std::uint64_t a, std::uint64_t b) {

@@ -31,7 +31,7 @@
 ///  * Eq. 13 (Eq. 9 rewritten with e^{p/b} e^{-p} = e^{-p(1-1/b)}) is algebraically exact; its
 ///    p -> infinity limit with b fixed is 1/(1 - e^{-p/b}) -> 1, i.e. O(1) as stated.
 ///
-/// Argument errors (n < 1, negative levels, p < 0, b < 1, ...) throw std::invalid_argument;
+/// Argument errors (n < 1, negative levels, p < 0, b < 1, ...) throw InternalError (util/error.h);
 /// the "_exact" integer variants throw std::overflow_error when the count exceeds uint64.
 
 #include <cstdint>

@@ -111,9 +111,8 @@ struct Lanes4 {
   static V far_of(V t0, V t1) { return _mm_max_ps(t0, t1); }
   static V entry_max(V a, V b) { return _mm_max_ps(a, b); }
 #if defined(AMALGAM_ISA_AVX2)
-  // The lower halves of the 8-wide forms, loaded as 4 floats: a cast of the 8-wide value made
-  // GCC load it whole, store its lower half to the stack and load that again (engine shadow
-  // rays: 999 -> 985 instructions per ray with the loads).
+  // The lower halves of the 8-wide forms, loaded as 4 floats: a cast of the 8-wide value
+  // makes GCC load it whole, store its lower half to the stack and load that again.
   static V origin(const WideRay& r, int a) {
     return low(r.o8[a]);
   }

@@ -60,7 +60,7 @@ Light read_sky(const JsonReader& r, const JsonValue& l, SkyInput& sky) {
     }
     try {
       *sky.map = std::make_shared<const SkyMap>(w, h, std::move(px), Vec3{1, 1, 1}, rotate);
-    } catch (const std::invalid_argument& e) {
+    } catch (const InputError& e) {
       r.fail(m->ptr, path.string() + ": " + e.what());
     }
     sky.inputs->push_back(path.string());

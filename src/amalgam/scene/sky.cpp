@@ -5,6 +5,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "amalgam/util/error.h"
+
 namespace amalgam {
 namespace {
 
@@ -31,14 +33,14 @@ SkyMap::SkyMap(int width, int height, std::vector<Vec3> pixels, Vec3 scale, floa
     : width_(width), height_(height), pixels_(std::move(pixels)), rotate_deg_(rotate_y_deg) {
   if (width <= 0 || height <= 0 ||
       pixels_.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height))
-    throw std::invalid_argument("the sky map's size does not match its pixels");
+    throw InputError("the sky map's size does not match its pixels");
   const double r = rotate_y_deg * kPi / 180.0;
   cos_r_ = static_cast<float>(std::cos(r)), sin_r_ = static_cast<float>(std::sin(r));
   for (Vec3& p : pixels_) {
     p = {p.x * scale.x, p.y * scale.y, p.z * scale.z};
     for (int k = 0; k < 3; ++k)
       if (!std::isfinite(p[k]) || p[k] < 0.0f)
-        throw std::invalid_argument("the sky map has a negative or non-finite value");
+        throw InputError("the sky map has a negative or non-finite value");
   }
   weight_.assign(pixels_.size(), 0.0);
   pixel_cdf_.assign(static_cast<std::size_t>(height) * (width + 1), 0.0);
@@ -57,7 +59,7 @@ SkyMap::SkyMap(int width, int height, std::vector<Vec3> pixels, Vec3 scale, floa
     row_sum[static_cast<std::size_t>(y)] = acc;
     total += acc;
   }
-  if (!(total > 0)) throw std::invalid_argument("the sky map has no light (all pixels black)");
+  if (!(total > 0)) throw InputError("the sky map has no light (all pixels black)");
   for (int y = 0; y < height; ++y) {
     const double rs = row_sum[static_cast<std::size_t>(y)];
     row_cdf_[static_cast<std::size_t>(y) + 1] = row_cdf_[static_cast<std::size_t>(y)] + rs / total;

@@ -23,7 +23,7 @@ namespace amalgam {
 class SkyMap {
  public:
   /// A map of width x height linear radiance pixels, rows from the top, scaled by `scale`
-  /// (RGB) and turned `rotate_y_deg` about +y. Throws std::invalid_argument when the sizes do
+  /// (RGB) and turned `rotate_y_deg` about +y. Throws InputError (util/error.h) when the sizes do
   /// not match, a value is negative or not finite, or no pixel has positive luminance.
   SkyMap(int width, int height, std::vector<Vec3> pixels, Vec3 scale = {1, 1, 1},
          float rotate_y_deg = 0.0f);

@@ -5,9 +5,9 @@
 /// at a time from SoA packs: the same hits and counts as the generic walk
 /// (tests/traverse/simd_test.cpp checks it against the scalar reference).
 ///
-/// Speed (docs/benchmarks.md, "Profiling and optimisation"): per ray, the watertight triangle
-/// setup is done once and a primitive hit's SurfaceHit is built only for the final closest hit;
-/// a node's box is fetched again only when the LOD policy may render on its level.
+/// Speed: per ray, the watertight triangle setup is done once and a primitive hit's SurfaceHit is
+/// built only for the final closest hit; a node's box is fetched again only when the LOD policy may
+/// render on its level.
 
 #include <algorithm>
 #include <bit>
@@ -164,11 +164,10 @@ class WideWalk {
   /// changed (after a leaf or a rendered amalgam), not at every pop.
   enum class Next { kEnter, kPop, kStop };
 
-  /// Always inlined into the pop loop: as a call per node it cost register saves and restores
-  /// and the box kernel's per-ray constants were set up again for every node (inlining it, with
-  /// the pushes straight onto the stack below, took the engine primary rays from 2 578 to
-  /// 2 133 instructions per ray; docs/benchmarks.md). kEnter: `it` is now the nearest hit
-  /// child, to be entered next (the other hit children are on the stack).
+  /// Always inlined into the pop loop, with the pushes straight onto the stack below: as a
+  /// call per node it would save and restore registers and set up the box kernel's per-ray
+  /// constants again for every node. kEnter: `it` is now the nearest hit child, to be entered
+  /// next (the other hit children are on the stack).
   ///
   /// An interior node is read from its reference alone: the record's address and the lanes
   /// in use come from it, the children's references from the record, beside their boxes.

@@ -5,8 +5,11 @@
 ///   one line naming the file and the place; the CLI exits 2.
 /// - `RuntimeError`: the input was fine but the work failed (a disk full, a write refused, a
 ///   helper process killed); the CLI exits 1.
-/// - `InternalError` (thrown by AMALGAM_CHECK, check.h): a broken invariant of our own; exit 1.
-/// Any other std::exception is a runtime failure too.
+/// - `InternalError` (thrown by AMALGAM_CHECK, check.h, and by a library function called
+///   outside its preconditions): a broken invariant of our own, a bug; exit 1. Every
+///   std::logic_error (std::invalid_argument, ...) counts as one.
+/// Any other std::exception is a runtime failure. `error_kind` is the one classification: the
+/// CLI's exit status and the Python module's exception both follow from it.
 
 #include <exception>
 #include <stdexcept>
@@ -32,9 +35,17 @@ struct InternalError : std::logic_error {
   using std::logic_error::logic_error;
 };
 
+/// Which kind of failure `e` is.
+enum class ErrorKind : unsigned char { kInput, kRuntime, kInternal };
+inline ErrorKind error_kind(const std::exception& e) {
+  if (dynamic_cast<const InputError*>(&e) != nullptr) return ErrorKind::kInput;
+  if (dynamic_cast<const std::logic_error*>(&e) != nullptr) return ErrorKind::kInternal;
+  return ErrorKind::kRuntime;
+}
+
 /// Exit status for a failure: 2 for bad input, 1 for everything else.
 inline int exit_status(const std::exception& e) {
-  return dynamic_cast<const InputError*>(&e) != nullptr ? 2 : 1;
+  return error_kind(e) == ErrorKind::kInput ? 2 : 1;
 }
 
 /// `text` on one line: newlines, carriage returns and tabs shown as spaces, trailing spaces

@@ -6,6 +6,7 @@
 
 #include "amalgam/hierarchy/bake/orientation.h"
 #include "amalgam/hierarchy/explicit.h"
+#include "amalgam/util/error.h"
 
 namespace amalgam {
 
@@ -62,7 +63,7 @@ double polygon_area(const Poly& p) {
 CellGrid bake_cells(const ExplicitHierarchy& mesh, const VolumeConfig& config) {
   if (config.levels < 1 || config.levels > 8 || config.dir_res < 1 || config.normal_res < 1 ||
       config.lines < 1)
-    throw std::invalid_argument("bake_cells: levels in [1, 8], resolutions and lines >= 1");
+    throw InternalError("bake_cells: levels in [1, 8], resolutions and lines >= 1");
   CellGrid g;
   g.levels = config.levels;
   g.dir_res = config.dir_res;
