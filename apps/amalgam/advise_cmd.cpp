@@ -167,11 +167,8 @@ Canvas strip(const RenderOutput& ref, const std::vector<Measured>& ms, int max_l
   return c;
 }
 
-}  // namespace
-
-int run_advise(CommonOptions& common, const AdviseOptions& a) {
-  common.finish();
-  // Every output is checked before any work.
+/// Refuses, before any work, outputs that cannot be written.
+void check_advise_outputs(const AdviseOptions& a) {
   if (!a.out.empty()) {
     if (!is_png_path(a.out)) throw InputError("--out " + a.out + ": the strip is a PNG (.png)");
     check_writable(a.out);
@@ -182,37 +179,12 @@ int run_advise(CommonOptions& common, const AdviseOptions& a) {
     if (std::filesystem::exists(a.keep, ec) && !std::filesystem::is_directory(a.keep, ec))
       throw InputError("--keep " + a.keep + ": exists and is not a directory");
   }
+}
 
-  set_activity("loading and building " + common.scene);
-  SceneFileConfig config;
-  config.smooth_normals = common.smooth_normals;
-  LoadedScene scene = load_scene(common.scene, common.params(), config);
-  common.prepare(scene);
-  print_warnings(scene);
-
-  RenderOptions base = common.options;
-  base.width = a.width, base.height = a.height;
-  base.sampler = PixelSampler::kStratified;
-  const bool quiet_json = a.json == "-";
-  std::ostream& log = quiet_json ? std::cerr : std::cout;
-
-  set_activity("rendering the reference");
-  RenderOptions ref_options = base;
-  ref_options.lod = FullDetail{};
-  ref_options.spp = a.reference_spp;
-  ref_options.seed = base.seed ^ 0x9e3779b97f4a7c15ULL;  // its own samples
-  const std::unique_ptr<Tracer> full = make_tracer(scene, ref_options);
-  const RenderOutput ref = full->render(ref_options);
-  log << "reference: full detail, " << a.reference_spp << " spp (stratified), "
-      << fixed(ref.seconds, 2) << " s\n";
-
-  double budget = a.seconds;
-  if (budget <= 0) {
-    RenderOptions o = base;
-    o.lod = FullDetail{}, o.spp = 16;
-    budget = full->render(o).seconds;
-  }
-
+/// Each candidate rendered for `budget` seconds of rendering, its RMSE against `ref`, and
+/// full detail's MSE x time over its own.
+std::vector<Measured> measure(const LoadedScene& scene, const RenderOptions& base,
+                              const RenderOutput& ref, double budget) {
   std::vector<Measured> ms;
   for (const Candidate& c : candidates(base)) {
     set_activity("rendering with " + c.name);
@@ -230,7 +202,12 @@ int run_advise(CommonOptions& common, const AdviseOptions& a) {
   // Error x time relative to full detail: above 1, lower error in the same time.
   const double base_cost = ms[0].rmse * ms[0].rmse * ms[0].out.seconds;
   for (Measured& m : ms) m.efficiency = base_cost / (m.rmse * m.rmse * m.out.seconds);
+  return ms;
+}
 
+/// The table and the verdict; returns the best level-of-detail renderer.
+const Measured& report(std::ostream& log, const std::vector<Measured>& ms, double budget,
+                       const AdviseOptions& a) {
   log << "time per renderer: " << fixed(budget, 3) << " s of rendering; " << a.width << "x"
       << a.height << ", stratified\n\n";
   char row[256];
@@ -261,45 +238,89 @@ int run_advise(CommonOptions& common, const AdviseOptions& a) {
       << "x full detail's error-per-time";
   if (have_embree()) log << " (Embree: " << fixed(ms[1].efficiency, 2) << "x)";
   log << ".\n";
+  return *best;
+}
 
-  if (!a.keep.empty()) {
-    std::filesystem::create_directories(a.keep);
-    write_image((std::filesystem::path(a.keep) / "reference.pfm").string(), ref.width, ref.height,
-                ref.image);
-    for (const Measured& m : ms)
-      write_image((std::filesystem::path(a.keep) / (m.c.key + ".pfm")).string(), m.out.width,
-                  m.out.height, m.out.image);
+/// Every image and the reference as PFM in --keep's directory, named by key.
+void keep_images(const AdviseOptions& a, const RenderOutput& ref, const std::vector<Measured>& ms) {
+  std::filesystem::create_directories(a.keep);
+  write_image((std::filesystem::path(a.keep) / "reference.pfm").string(), ref.width, ref.height,
+              ref.image);
+  for (const Measured& m : ms)
+    write_image((std::filesystem::path(a.keep) / (m.c.key + ".pfm")).string(), m.out.width,
+                m.out.height, m.out.image);
+}
+
+/// The table as JSON (--json FILE or -).
+void write_json(const AdviseOptions& a, const std::string& scene, double budget,
+                const RenderOutput& ref, const std::vector<Measured>& ms, const Measured& best) {
+  nlohmann::ordered_json j;
+  j["scene"] = scene;
+  j["width"] = a.width, j["height"] = a.height;
+  j["render_seconds_each"] = budget;
+  j["reference"] = {{"spp", a.reference_spp}, {"seconds", ref.seconds}};
+  for (const Measured& m : ms) {
+    nlohmann::ordered_json r;
+    r["name"] = m.c.name;
+    r["key"] = m.c.key;
+    r["spp"] = m.out.spp;
+    r["render_seconds"] = m.out.seconds;
+    r["setup_seconds"] = m.setup_s;
+    if (m.c.options.tracer == TracerKind::kAmalgam)
+      r["tests_per_primary_ray"] = m.out.per_primary.mean();
+    r["rmse"] = m.rmse;
+    r["vs_full_detail"] = m.efficiency;
+    j["renderers"].push_back(r);
   }
+  j["best_level_of_detail"] = best.c.key;
+  if (a.json == "-")
+    std::cout << j.dump(2) << "\n";
+  else
+    write_file_atomic(a.json, j.dump(2) + "\n");
+}
+
+}  // namespace
+
+int run_advise(CommonOptions& common, const AdviseOptions& a) {
+  common.finish();
+  check_advise_outputs(a);
+  set_activity("loading and building " + common.scene);
+  SceneFileConfig config;
+  config.smooth_normals = common.smooth_normals;
+  LoadedScene scene = load_scene(common.scene, common.params(), config);
+  common.prepare(scene);
+  print_warnings(scene);
+
+  RenderOptions base = common.options;
+  base.width = a.width, base.height = a.height;
+  base.sampler = PixelSampler::kStratified;
+  std::ostream& log = a.json == "-" ? std::cerr : std::cout;
+
+  set_activity("rendering the reference");
+  RenderOptions ref_options = base;
+  ref_options.lod = FullDetail{};
+  ref_options.spp = a.reference_spp;
+  ref_options.seed = base.seed ^ 0x9e3779b97f4a7c15ULL;  // its own samples
+  const std::unique_ptr<Tracer> full = make_tracer(scene, ref_options);
+  const RenderOutput ref = full->render(ref_options);
+  log << "reference: full detail, " << a.reference_spp << " spp (stratified), "
+      << fixed(ref.seconds, 2) << " s\n";
+  double budget = a.seconds;
+  if (budget <= 0) {
+    RenderOptions o = base;
+    o.lod = FullDetail{}, o.spp = 16;
+    budget = full->render(o).seconds;
+  }
+
+  const std::vector<Measured> ms = measure(scene, base, ref, budget);
+  const Measured& best = report(log, ms, budget, a);
+  if (!a.keep.empty()) keep_images(a, ref, ms);
   if (!a.out.empty()) {
     const Canvas c = strip(ref, ms, scene.info().levels - 1, a.reference_spp);
     write_image(a.out, c.width, c.height, c.pixels);
     log << "strip: " << a.out << "\n";
   }
-  if (!a.json.empty()) {
-    nlohmann::ordered_json j;
-    j["scene"] = common.scene;
-    j["width"] = a.width, j["height"] = a.height;
-    j["render_seconds_each"] = budget;
-    j["reference"] = {{"spp", a.reference_spp}, {"seconds", ref.seconds}};
-    for (const Measured& m : ms) {
-      nlohmann::ordered_json r;
-      r["name"] = m.c.name;
-      r["key"] = m.c.key;
-      r["spp"] = m.out.spp;
-      r["render_seconds"] = m.out.seconds;
-      r["setup_seconds"] = m.setup_s;
-      if (m.c.options.tracer == TracerKind::kAmalgam)
-        r["tests_per_primary_ray"] = m.out.per_primary.mean();
-      r["rmse"] = m.rmse;
-      r["vs_full_detail"] = m.efficiency;
-      j["renderers"].push_back(r);
-    }
-    j["best_level_of_detail"] = best->c.key;
-    if (a.json == "-")
-      std::cout << j.dump(2) << "\n";
-    else
-      write_file_atomic(a.json, j.dump(2) + "\n");
-  }
+  if (!a.json.empty()) write_json(a, common.scene, budget, ref, ms, best);
   return 0;
 }
 
