@@ -12,6 +12,7 @@
 #include "amalgam/analysis/formulas.h"
 #include "amalgam/analysis/metrics.h"
 #include "amalgam/scene/sky.h"
+#include "amalgam/util/check.h"
 
 namespace amalgam {
 namespace error_test {
@@ -44,6 +45,36 @@ TEST(ErrorKind, LibraryFunctionsThrowTheirKind) {
   } catch (const std::exception& e) {
     EXPECT_EQ(error_kind(e), ErrorKind::kInput) << e.what();
   }
+}
+
+// A failed comparison check names both values; each side is evaluated once.
+TEST(Check, ComparisonsPrintTheValuesCompared) {
+  int evaluated = 0;
+  const auto nine = [&] { return ++evaluated, 9; };
+  try {
+    AMALGAM_CHECK_LE(nine(), 8, "too many children");
+    FAIL() << "no throw";
+  } catch (const InternalError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("nine() <= 8 (9 vs 8)"), std::string::npos) << m;
+    EXPECT_NE(m.find("too many children"), std::string::npos) << m;
+  }
+  EXPECT_EQ(evaluated, 1);
+  AMALGAM_CHECK_EQ(nine(), 9, "passes");
+  EXPECT_EQ(evaluated, 2);
+}
+
+// AMALGAM_DCHECK runs in debug builds only: in a release build its condition is not evaluated.
+TEST(Check, DcheckRunsOnlyInDebugBuilds) {
+  int evaluated = 0;
+  const auto fails = [&] { return ++evaluated, false; };
+#ifdef NDEBUG
+  AMALGAM_DCHECK(fails(), "not evaluated");
+  EXPECT_EQ(evaluated, 0);
+#else
+  EXPECT_THROW(AMALGAM_DCHECK(fails(), "evaluated"), InternalError);
+  EXPECT_EQ(evaluated, 1);
+#endif
 }
 
 }  // namespace error_test

@@ -28,14 +28,14 @@ std::vector<Primitive> PrimitiveStore::to_vector() const {
 
 void PrimitiveStore::pack(std::span<const PrimRange> leaves, std::span<std::uint32_t> first_pack) {
   AMALGAM_CHECK(!packed_, "PrimitiveStore::pack: already packed");
-  AMALGAM_CHECK(first_pack.size() == leaves.size(), "PrimitiveStore::pack: one start per leaf");
-  AMALGAM_CHECK(whole_.size() < kWhole, "PrimitiveStore::pack: more than 2^31 primitives");
+  AMALGAM_CHECK_EQ(first_pack.size(), leaves.size(), "PrimitiveStore::pack: one start per leaf");
+  AMALGAM_CHECK_LT(whole_.size(), kWhole, "PrimitiveStore::pack: more than 2^31 primitives");
   std::size_t n_packs = 0;
   for (std::size_t k = 0; k < leaves.size(); ++k) {
     first_pack[k] = static_cast<std::uint32_t>(n_packs);
     n_packs += (leaves[k].count + kWideLanes - 1) / kWideLanes;
   }
-  AMALGAM_CHECK(n_packs <= kWhole / kWideLanes, "PrimitiveStore::pack: too many packs");
+  AMALGAM_CHECK_LE(n_packs, kWhole / kWideLanes, "PrimitiveStore::pack: too many packs");
   constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
   const std::size_t n = whole_.size();

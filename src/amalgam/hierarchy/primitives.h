@@ -19,6 +19,7 @@
 
 #include "amalgam/geometry/wide.h"
 #include "amalgam/scene/scene.h"
+#include "amalgam/util/check.h"
 
 namespace amalgam {
 
@@ -55,8 +56,12 @@ class PrimitiveStore {
     a = p.a, b = p.b, c = p.c;
   }
   /// Primitive `i` by reference, for loops that read the whole form many times (the bake).
-  /// Requires the whole form (`edit()` first).
-  const Primitive& unpacked(std::size_t i) const { return whole_[i]; }
+  /// Requires the whole form (`edit()` first): checked in debug builds.
+  const Primitive& unpacked(std::size_t i) const {
+    AMALGAM_DCHECK(!packed_, "PrimitiveStore::unpacked: the store is packed (edit() first)");
+    AMALGAM_DCHECK_LT(i, whole_.size(), "PrimitiveStore::unpacked: index out of range");
+    return whole_[i];
+  }
   PrimKind kind(std::size_t i) const {
     if (!packed_) return whole_[i].kind;
     const std::uint32_t s = slot_[i];

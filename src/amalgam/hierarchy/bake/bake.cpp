@@ -386,7 +386,7 @@ void bake(InstancedHierarchy& h, const BakeConfig& config) {
     const ExplicitNode& node = h.top_nodes[i];
     ChildBuffer buf;
     BakeChild* kids = buf.data();
-    AMALGAM_CHECK(node.count <= kMaxChildren, "bake: a node with more than kMaxChildren children");
+    AMALGAM_CHECK_LE(node.count, kMaxChildren, "bake: a node with more than kMaxChildren children");
     const int k = node.count;
     for (int c = 0; c < k; ++c) {
       if (node.leaf) {

@@ -88,7 +88,7 @@ InstancedHierarchy build_instanced(std::vector<ExplicitHierarchy> meshes,
   AMALGAM_CHECK(instances.size() < 0xffffffffull, "build_instanced: more than 2^32 - 2 instances");
   h.instances.reserve(instances.size());
   for (const Instance& inst : instances) {
-    AMALGAM_CHECK(inst.mesh < h.meshes.size(), "build_instanced: mesh index out of range");
+    AMALGAM_CHECK_LT(inst.mesh, h.meshes.size(), "build_instanced: mesh index out of range");
     const ExplicitHierarchy& mesh = h.meshes[inst.mesh];
     if (mesh.prims.empty()) continue;
     h.instances.push_back(InstancedHierarchy::make_instance(inst, mesh));
