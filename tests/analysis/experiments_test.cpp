@@ -137,6 +137,19 @@ TEST(Experiments, ExpectedMatchesEq9AndRefutesPrintedEq12) {
           << "the printed Eq. 12 limit (1 - e^-n) is below every measurement";
     }
   }
+  // The deepest traditional point, l_max = 20, is measured and kept: with the light at the
+  // camera and every ray hitting (p = 2^20), the shadow ray crosses back over exactly the cells
+  // the primary ray entered, so the mean tests agree exactly (a shadow ray whose origin, offset
+  // by the hit's rounding-error bound, left the hit's unit cell would make fewer).
+  bool deepest = false;
+  for (std::size_t i = 0; i < r.table.rows.size(); ++i)
+    if (r.table.at(i, "sweep") == 0 && r.table.at(i, "l_max") == 20) {
+      deepest = true;
+      EXPECT_EQ(r.table.at(i, "mean_shadow"), r.table.at(i, "mean_tests"));
+      EXPECT_GE(r.table.at(i, "mean_tests"), 2 * 20 + 1) << "root and n children per level";
+    }
+  EXPECT_TRUE(deepest) << "the l_max = 20 point is part of the sweep";
+  EXPECT_EQ(r.findings.find("Left out"), std::string::npos) << r.findings;
 }
 
 TEST(Experiments, FailedTestsMatchCorrectedSecondLookSum) {

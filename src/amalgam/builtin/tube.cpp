@@ -14,9 +14,13 @@ TubeHierarchy::TubeHierarchy(const Config& c) : c_(c) {
   for (int l = 1; l <= c_.depth; ++l) count_[l] = count_[l - 1] * static_cast<std::uint64_t>(c_.n);
   for (int l = 0; l <= c_.depth; ++l)
     width_[l] = static_cast<double>(count_[c_.depth]) / static_cast<double>(count_[l]);
-  // The line ends at x = 0, where coordinates are most precise: the hit primitive and the
-  // origins of the shadow rays lie near the end of the line.
-  x0_ = -width_[0];
+  // Put the primary hits where coordinates are most precise, near x = 0: the line's hit is its
+  // last primitive, so the line ends at x = 0; a Poisson realisation is hit first near the
+  // camera's end (within a few cells of it once p is large), so it starts at x = 0. A hit
+  // 2^20 from the origin would have float spacing 1/16 there, and the shadow ray's offset by the
+  // hit's rounding-error bound (gamma(5) |p|, 0.31 at 2^20) would leave the unit cell the hit
+  // lies in, starting the shadow ray past the cells it has to cross.
+  x0_ = c_.mode == Mode::kLine ? -width_[0] : 0.0;
 }
 
 bool TubeHierarchy::on_axis(PrimId k) const {
@@ -58,7 +62,7 @@ HierarchyInfo TubeHierarchy::info() const {
 
 Environment TubeHierarchy::environment(int lights) const {
   Environment e;
-  const float cam = static_cast<float>(2.0 * x0_);
+  const float cam = static_cast<float>(x0_ - width_[0]);
   e.camera.position = {cam, 0, 0};
   e.camera.look_at = {0, 0, 0};
   e.camera.up = {0, 1, 0};

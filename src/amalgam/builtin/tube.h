@@ -3,12 +3,13 @@
 /// builtin:poisson (the expected-case model of Eq. 9).
 ///
 /// Nodes are nested intervals along the x axis: node k on level l spans
-/// [x0 + k w_l, x0 + (k + 1) w_l] x [-1/2, 1/2]^2 with w_l = n^(l_max - l) and x0 = -n^l_max
-/// (the line ends at x = 0, where floats are finest); each node has n
+/// [x0 + k w_l, x0 + (k + 1) w_l] x [-1/2, 1/2]^2 with w_l = n^(l_max - l); x0 = -n^l_max for
+/// the line (it ends at x = 0, at its hit primitive) and x0 = 0 for poisson (it starts at
+/// x = 0, near its first hits): the hits lie where floats are finest. Each node has n
 /// children; leaf cells (level l_max - 1 nodes) hold n primitives, one per unit cell. Each
 /// primitive is a sphere of radius 0.2, either on the x axis (the default primary ray hits
 /// it) or 0.3 off it (the ray misses it). The camera and a point light sit on the axis at
-/// x = 2 x0, so the default ray and its shadow ray examine the whole line.
+/// x = x0 - n^l_max, so the default ray and its shadow ray examine the whole line.
 
 #include <cmath>
 #include <cstdint>
@@ -68,7 +69,7 @@ class TubeHierarchy {
   }
   const Config& config() const { return c_; }
   /// Number of primitives, n^l_max.
-  /// The environment: camera at the origin looking down +x, point light(s) at the camera.
+  /// The environment: camera at x0 - n^l_max looking down +x, point light(s) at the camera.
   Environment environment(int lights) const;
 
   static constexpr int level_of(NodeId id) { return static_cast<int>(id >> 58); }
