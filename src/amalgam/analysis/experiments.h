@@ -181,6 +181,27 @@ ExperimentResult p_vs_primitives(const Config& c);
 ExperimentResult premise(const Config& c);
 ExperimentResult sorting(const Config& c);
 
+/// Wall times of repeated runs of a render against those of a reference render (premise's "no
+/// slower"). Each median gets a distribution-free confidence interval [x(k), x(n+1-k)] of its n
+/// sorted runs, k the largest rank with a coverage of at least 95% (9 runs: the 2nd to the 8th,
+/// 96.1%), or the whole range (k = 1, coverage 1 - 2^(1-n)) when n is too small for 95%.
+struct TimeRatio {
+  double median = 0;  ///< median(seconds) / median(reference)
+  /// The ratio's interval: [seconds' low / reference's high, seconds' high / reference's low].
+  double lo = 0, hi = 0;
+  double coverage = 0;  ///< of each median's interval (the smaller of the two)
+  /// +1 slower (lo > 1), -1 faster (hi < 1), 0 a tie (the interval holds 1).
+  int order = 0;
+};
+/// Throws std::invalid_argument when either list is empty.
+TimeRatio time_ratio(const std::vector<double>& seconds, const std::vector<double>& reference);
+
+/// premise's checks of "no slower" for one scale-sensitive render (`label`) against the
+/// traditional render of the same scene: it makes no more tests (`tests_ratio` <= 1) and is not
+/// slower in wall time (a tie passes; only `time.order` > 0 fails). Statement "No slower".
+std::vector<Check> no_slower_checks(const std::string& label, double tests_ratio,
+                                    const TimeRatio& time);
+
 /// Least-squares fit y = a + b x; returns {a, b, r^2} and the slope's standard error and
 /// 95% confidence half-width (Student t with n - 2 degrees of freedom; 0 for n < 3).
 struct LinearFit {
