@@ -35,39 +35,59 @@ $s6 << EOD
 16 0.001988474309
 EOD
 $s7 << EOD
+1 0.03106870516
+4 0.007768716264
+16 0.001946915961
+EOD
+$s8 << EOD
+1 0.0325769971
+4 0.008149084724
+16 0.002039702195
+EOD
+$s9 << EOD
 99.81673855 0.03106264103
 399.9388292 0.007767331927
 1601.084581 0.001946555904
 EOD
-$s8 << EOD
+$s10 << EOD
 18.57274712 0.02895632527
 74.27233209 0.007215372727
 297.0413547 0.001818625089
 EOD
-$s9 << EOD
+$s11 << EOD
 28.19315592 0.03035441218
 112.5473768 0.007520648825
 450.1406928 0.001866430645
 EOD
-$s10 << EOD
+$s12 << EOD
 37.67441813 0.03116131161
 150.8186646 0.007798730481
 603.0425822 0.001936519596
 EOD
-$s11 << EOD
+$s13 << EOD
 47.21028646 0.03159422704
 188.5564643 0.007815258739
 753.3520237 0.001962031179
 EOD
-$s12 << EOD
+$s14 << EOD
 56.28666178 0.03161703533
 225.0673421 0.007971243402
 900.5646566 0.001999711673
 EOD
-$s13 << EOD
+$s15 << EOD
 65.20081923 0.03186150501
 261.0545858 0.007973571267
 1044.392897 0.001988474309
+EOD
+$s16 << EOD
+99.28905572 0.03106870516
+397.3773939 0.007768716264
+1590.101759 0.001946915961
+EOD
+$s17 << EOD
+65.39107937 0.0325769971
+261.8136258 0.008149084724
+1047.321642 0.002039702195
 EOD
 set terminal pngcairo size 1280,480 noenhanced font 'sans,10'
 set output "noise.png.tmp"
@@ -86,18 +106,22 @@ plot $s0 using 1:2 with linespoints pt 7 ps 0.8 title "traditional", \
      $s3 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 4", \
      $s4 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 5", \
      $s5 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 6", \
-     $s6 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 7"
+     $s6 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 7", \
+     $s7 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, footprint 1", \
+     $s8 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, footprint 2"
 unset logscale
 set logscale x
 set logscale y
 set title "Variance vs cost"
 set xlabel "intersection tests per pixel"
 set ylabel "mean per-pixel variance"
-plot $s7 using 1:2 with linespoints pt 7 ps 0.8 title "traditional", \
-     $s8 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 2", \
-     $s9 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 3", \
-     $s10 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 4", \
-     $s11 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 5", \
-     $s12 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 6", \
-     $s13 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 7"
+plot $s9 using 1:2 with linespoints pt 7 ps 0.8 title "traditional", \
+     $s10 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 2", \
+     $s11 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 3", \
+     $s12 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 4", \
+     $s13 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 5", \
+     $s14 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 6", \
+     $s15 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, level 7", \
+     $s16 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, footprint 1", \
+     $s17 using 1:2 with linespoints pt 7 ps 0.8 title "stochastic, footprint 2"
 unset multiplot
