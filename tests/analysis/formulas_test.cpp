@@ -1,7 +1,6 @@
 // Tests for amalgam::formulas (Thompson & Fussell, TR-91-01, Eqs. 1-13).
 
 #include "amalgam/analysis/formulas.h"
-#include "amalgam/util/error.h"
 
 #include <gtest/gtest.h>
 
@@ -13,6 +12,8 @@
 #include <stdexcept>
 #include <utility>
 #include <vector>
+
+#include "amalgam/util/error.h"
 
 namespace f = amalgam::formulas;
 
