@@ -68,7 +68,6 @@ class TubeHierarchy {
     return {static_cast<float>(x0_ + static_cast<double>(k) + 0.5), on_axis(k) ? 0.0f : 0.3f, 0.0f};
   }
   const Config& config() const { return c_; }
-  /// Number of primitives, n^l_max.
   /// The environment: camera at x0 - n^l_max looking down +x, point light(s) at the camera.
   Environment environment(int lights) const;
 
