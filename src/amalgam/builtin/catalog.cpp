@@ -26,6 +26,9 @@ BuiltinScene make_tube(const std::string& name, const Params& p, TubeHierarchy::
     c.p = p.get_double("p", 64.0, 1e-9, 1e15);
     c.seed = static_cast<std::uint64_t>(p.get_int("seed", 0, 0, INT64_MAX));
   }
+  c.m = static_cast<int>(p.get_int("m", 0, 0, kMaxChildren - c.n));
+  if (std::pow(static_cast<double>(c.n), c.depth) * (1 + c.m) >= kMaxIndex)
+    throw InputError(name + ": n^depth (1 + m) objects exceed 2^58");
   const int lights = read_lights(p);
   p.check_all_used();
   TubeHierarchy h(c);
@@ -63,6 +66,8 @@ const std::vector<BuiltinDoc>& builtin_docs() {
         "depth (default 6): l_max; primitives (n^depth of them) are on level l_max",
         "alpha (default 0, 0..1): opacity of every amalgam that does not hold the hit "
         "primitive (those that do are opaque)",
+        "m (default 0, 0..64-n): failed objects per node, tested and missed by the default "
+        "ray (\"A Second Look\")",
         "lights (default 1, 1..64): point lights, all at the camera on the line"}},
       {"prisms",
        "The paper's Figure 2: nested rectangular-prism amalgams, split^3 children each; "
@@ -78,7 +83,8 @@ const std::vector<BuiltinDoc>& builtin_docs() {
        "a level-l node is passed without a hit with probability exp(-p / n^l).",
        {"n (default 2)", "depth (default 10): l_max",
         "p (default 64): expected hits along the ray through the whole scene",
-        "seed (default 0): which realisation of the process", "lights (default 1, 1..64)"}},
+        "seed (default 0): which realisation of the process",
+        "m (default 0): failed objects per node, as for line", "lights (default 1, 1..64)"}},
       {"demo",
        "The demo: builtin:prisms seen from a corner, 9 levels (33.5 million primitives); with "
        "--footprint the far amalgams are rendered as primitives.",

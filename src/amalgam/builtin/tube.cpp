@@ -1,6 +1,7 @@
 #include "amalgam/builtin/tube.h"
 
 #include <cmath>
+#include <numbers>
 
 #include "amalgam/math/random.h"
 #include "amalgam/util/check.h"
@@ -10,8 +11,13 @@ namespace amalgam {
 TubeHierarchy::TubeHierarchy(const Config& c) : c_(c) {
   AMALGAM_CHECK(c_.n >= 2 && c_.n <= kMaxChildren, "TubeHierarchy: n must be in [2, kMaxChildren]");
   AMALGAM_CHECK(c_.depth >= 1 && c_.depth < kMaxLevels, "TubeHierarchy: depth out of range");
+  AMALGAM_CHECK(c_.m >= 0 && c_.n + c_.m <= kMaxChildren,
+                "TubeHierarchy: n + m must be at most kMaxChildren");
   count_[0] = 1;
-  for (int l = 1; l <= c_.depth; ++l) count_[l] = count_[l - 1] * static_cast<std::uint64_t>(c_.n);
+  for (int l = 1; l <= c_.depth; ++l) {
+    count_[l] = count_[l - 1] * static_cast<std::uint64_t>(c_.n);
+    offset_[l] = offset_[l - 1] + count_[l - 1];
+  }
   for (int l = 0; l <= c_.depth; ++l)
     width_[l] = static_cast<double>(count_[c_.depth]) / static_cast<double>(count_[l]);
   // Put the primary hits where coordinates are most precise, near x = 0: the line's hit is its
@@ -24,12 +30,28 @@ TubeHierarchy::TubeHierarchy(const Config& c) : c_(c) {
 }
 
 bool TubeHierarchy::on_axis(PrimId k) const {
+  if (k >= count_[c_.depth]) return false;  // a failed object
   if (c_.mode == Mode::kLine) return k + 1 == count_[c_.depth];
   // Poisson: hits per unit cell are Bernoulli(q) with q = 1 - exp(-p / n^l_max), so the
   // probability of no hit in a level-l node is exactly exp(-p / n^l).
   const double q = -std::expm1(-c_.p / static_cast<double>(count_[c_.depth]));
   const double u = static_cast<double>(mix64(hash_combine(c_.seed, k)) >> 11) * 0x1.0p-53;
   return u < q;
+}
+
+Vec3 TubeHierarchy::prim_centre(PrimId k) const {
+  if (k < count_[c_.depth])
+    return {static_cast<float>(x0_ + static_cast<double>(k) + 0.5), on_axis(k) ? 0.0f : 0.3f, 0.0f};
+  // A failed object: find its node (level l, index i) and place it at the node's centre, on a
+  // circle of radius 0.3 around the axis (radius 0.2: inside the node's box, off the axis).
+  const std::uint64_t g = (k - count_[c_.depth]) / static_cast<std::uint64_t>(c_.m);
+  const int j = static_cast<int>((k - count_[c_.depth]) % static_cast<std::uint64_t>(c_.m));
+  int l = 0;
+  while (l + 1 < c_.depth && g >= offset_[l + 1]) ++l;
+  const double i = static_cast<double>(g - offset_[l]);
+  const double a = 2.0 * std::numbers::pi * j / c_.m;
+  return {static_cast<float>(x0_ + (i + 0.5) * width_[l]), static_cast<float>(0.3 * std::cos(a)),
+          static_cast<float>(0.3 * std::sin(a))};
 }
 
 Appearance TubeHierarchy::appearance(NodeId id) const {
@@ -47,15 +69,17 @@ Appearance TubeHierarchy::appearance(NodeId id) const {
 
 Surface TubeHierarchy::surface(PrimId k) const {
   Surface s;
-  const float hue = static_cast<float>((static_cast<double>(k) + 0.5) / count_[c_.depth]);
+  const float hue = k < count_[c_.depth]
+                        ? static_cast<float>((static_cast<double>(k) + 0.5) / count_[c_.depth])
+                        : 0.5f;
   s.colour = {0.3f + 0.6f * hue, 0.5f, 0.9f - 0.6f * hue};
   return s;
 }
 
 HierarchyInfo TubeHierarchy::info() const {
   HierarchyInfo i;
-  i.primitives = static_cast<double>(count_[c_.depth]);
   for (int l = 0; l < c_.depth; ++l) i.nodes += static_cast<double>(count_[l]);
+  i.primitives = static_cast<double>(count_[c_.depth]) + i.nodes * c_.m;
   i.levels = c_.depth + 1;
   return i;
 }

@@ -10,6 +10,11 @@
 /// primitive is a sphere of radius 0.2, either on the x axis (the default primary ray hits
 /// it) or 0.3 off it (the ray misses it). The camera and a point light sit on the axis at
 /// x = x0 - n^l_max, so the default ray and its shadow ray examine the whole line.
+///
+/// With m > 0 every node also holds m "failed" objects (the paper's "A Second Look"): spheres
+/// of radius 0.2 at its centre, 0.3 off the axis at angles 2 pi j / m, listed after its n
+/// children. A ray along the axis tests them and misses them, so every entered node costs
+/// n + m tests while the traversal still continues through n children.
 
 #include <cmath>
 #include <cstdint>
@@ -30,6 +35,7 @@ class TubeHierarchy {
     double alpha = 0.0;      ///< line: opacity of amalgams not holding the hit primitive
     double p = 64.0;         ///< poisson: expected hits along the axis through the scene
     std::uint64_t seed = 0;  ///< poisson: which realisation of the process
+    int m = 0;               ///< failed objects per node (n + m <= kMaxChildren)
   };
 
   explicit TubeHierarchy(const Config& c);
@@ -54,6 +60,9 @@ class TubeHierarchy {
         return;
       }
     }
+    const std::uint64_t failed = failed_base(l, index_of(id));
+    for (int j = 0; j < c_.m; ++j)
+      if (!f(Child{failed + static_cast<std::uint64_t>(j), true})) return;
   }
   std::optional<SurfaceHit> intersect(PrimId k, const Ray& ray) const {
     return intersect_sphere(ray, prim_centre(k), 0.2f);
@@ -64,9 +73,7 @@ class TubeHierarchy {
 
   /// True when primitive k lies on the axis (is hit by the default ray).
   bool on_axis(PrimId k) const;
-  Vec3 prim_centre(PrimId k) const {
-    return {static_cast<float>(x0_ + static_cast<double>(k) + 0.5), on_axis(k) ? 0.0f : 0.3f, 0.0f};
-  }
+  Vec3 prim_centre(PrimId k) const;
   const Config& config() const { return c_; }
   /// The environment: camera at x0 - n^l_max looking down +x, point light(s) at the camera.
   Environment environment(int lights) const;
@@ -78,8 +85,15 @@ class TubeHierarchy {
   }
 
  private:
+  /// The id of the first failed object of node (l, k): failed objects follow the n^l_max
+  /// primitives, m per node, nodes in level order.
+  std::uint64_t failed_base(int l, std::uint64_t k) const {
+    return count_[c_.depth] + (offset_[l] + k) * static_cast<std::uint64_t>(c_.m);
+  }
+
   Config c_;
   double x0_ = -1.0;
+  std::uint64_t offset_[kMaxLevels]{};  ///< nodes on the levels above l
   double width_[kMaxLevels]{};
   std::uint64_t count_[kMaxLevels]{};
 };
