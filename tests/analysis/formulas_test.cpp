@@ -219,6 +219,52 @@ TEST(Formulas, EfficientFraction) {
   EXPECT_THROW(f::efficient_fraction_exact(2, 3), amalgam::InternalError);
 }
 
+// Eq. 7's exact counterpart: the cost of a sorted traversal stopped by the i-th amalgam of
+// l1, against a direct walk of the implicit tree (node k of level l is reached when one of
+// the first i amalgams lies under it), and its bounds around i C_b.
+TEST(Formulas, CostOfReachingTheIthAmalgam) {
+  for (int n = 2; n <= 5; ++n)
+    for (int l1 = 0; l1 <= 5; ++l1) {
+      const double b = ipow(n, l1);
+      for (double i = 1; i <= b; ++i) {
+        double reached = 0, entered = 0;
+        for (int l = 0; l <= l1; ++l) {
+          const double width = ipow(n, l1 - l);  // amalgams of l1 under a node of level l
+          for (double k = 0; k < ipow(n, l); ++k)
+            if (k * width < i) ++reached, entered += l < l1;
+        }
+        EXPECT_EQ(f::objects_traversed_to(n, l1, i), reached) << n << " " << l1 << " " << i;
+        EXPECT_EQ(f::tests_to(n, l1, i), 1 + n * entered) << n << " " << l1 << " " << i;
+        const double eq7 = f::eq7_linear_cost(n, i);
+        EXPECT_LE(std::fabs(reached - eq7), l1 + 1);
+        EXPECT_LE(std::fabs(1 + n * entered - eq7), n * l1 + 1);
+      }
+      EXPECT_EQ(f::objects_traversed_to(n, l1, 1), l1 + 1);                    // Eq. 4, attained
+      EXPECT_EQ(f::objects_traversed_to(n, l1, b), double(power_sum(n, l1)));  // Eq. 5
+    }
+  EXPECT_THROW(f::objects_traversed_to(2, 3, 9), amalgam::InternalError);
+  EXPECT_THROW(f::tests_to(2, 3, 0), amalgam::InternalError);
+}
+
+// Failed objects in the expected case: every entered node costs n + m tests, so the
+// expectation is 1 + (1 + m/n)(E_0 - 1), and p = 0 gives the worst-case Second-Look sum.
+TEST(Formulas, ExpectedTestsWithFailedObjects) {
+  for (int n = 2; n <= 4; ++n)
+    for (int l = 1; l <= 6; ++l)
+      for (int m : {0, 1, 6})
+        for (double p : {0.0, 0.5, 8.0, 1000.0}) {
+          const double k = 1.0 + double(m) / n;
+          EXPECT_NEAR(f::expected_tests_sorted(n, l, p, m),
+                      1 + k * (f::expected_tests_sorted(n, l, p) - 1), 1e-9);
+          EXPECT_NEAR(f::expected_tests_traditional(n, l, p, m),
+                      1 + k * (f::expected_tests_traditional(n, l, p) - 1), 1e-9);
+          if (p == 0) {
+            EXPECT_DOUBLE_EQ(f::expected_tests_traditional(n, l, p, m),
+                             f::failed_tests_worst(n, m, l));
+          }
+        }
+}
+
 TEST(Formulas, FailedTestsWorstCase) {
   for (int n = 1; n <= 5; ++n) {
     for (int l1 = 0; l1 <= 6; ++l1) {

@@ -103,10 +103,71 @@ $s9 << EOD
 11 90113
 12 196609
 EOD
-set terminal pngcairo size 640,480 noenhanced font 'sans,10'
+$s10 << EOD
+2 18.06133333
+3 26.392
+4 34.4
+5 42.4
+6 50.4
+7 58.4
+8 66.4
+9 74.4
+10 82.4
+11 90.4
+12 98.4
+13 106.4
+14 114.4
+EOD
+$s11 << EOD
+2 18.08268227
+3 26.39556251
+4 34.40408177
+5 42.40408553
+6 50.40408553
+7 58.40408553
+8 66.40408553
+9 74.40408553
+10 82.40408553
+11 90.40408553
+12 98.40408553
+13 106.4040855
+14 114.4040855
+EOD
+$s12 << EOD
+2 5.265333333
+3 7.348
+4 9.35
+5 11.35
+6 13.35
+7 15.35
+8 17.35
+9 19.35
+10 21.35
+11 23.35
+12 25.35
+13 27.35
+14 29.35
+EOD
+$s13 << EOD
+2 5.270670566
+3 7.348890626
+4 9.351020442
+5 11.35102138
+6 13.35102138
+7 15.35102138
+8 17.35102138
+9 19.35102138
+10 21.35102138
+11 23.35102138
+12 25.35102138
+13 27.35102138
+14 29.35102138
+EOD
+set terminal pngcairo size 1280,480 noenhanced font 'sans,10'
 set output "failed-tests.png.tmp"
 set key top left box opaque
 set grid
+set multiplot layout 1,2
 unset logscale
 set logscale y
 set title "Primary-ray tests with failed tests (builtin:prisms, front view)"
@@ -122,3 +183,12 @@ plot $s0 using 1:2 with linespoints pt 7 ps 0.8 title "measured, split=2", \
      $s7 using 1:2 with lines lw 2 title "corrected sum, split=4", \
      $s8 using 1:2 with lines lw 2 title "C_s0 (no failed tests), n=4", \
      $s9 using 1:2 with lines lw 2 title "sum as printed (typo), split=2"
+unset logscale
+set title "Expected case with and without failed objects (builtin:poisson, traditional, p = 2^{l_max})"
+set xlabel "log2 p"
+set ylabel "mean intersection tests, primary ray"
+plot $s10 using 1:2 with linespoints pt 7 ps 0.8 title "measured, m = 6", \
+     $s11 using 1:2 with lines lw 2 title "exact expectation, m = 6", \
+     $s12 using 1:2 with linespoints pt 7 ps 0.8 title "measured, m = 0", \
+     $s13 using 1:2 with lines lw 2 title "exact expectation, m = 0"
+unset multiplot

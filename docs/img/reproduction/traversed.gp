@@ -178,11 +178,123 @@ $s14 << EOD
 2 1.140625
 3 1.142578125
 EOD
-set terminal pngcairo size 1280,480 noenhanced font 'sans,10'
+$s15 << EOD
+1 4.5
+2 2.5
+3 2
+4 1.625
+6 1.416666667
+8 1.25
+12 1.166666667
+16 1.09375
+24 1.0625
+32 1.03125
+48 1.020833333
+64 1.0078125
+96 1.005208333
+128 1
+192 1
+256 0.998046875
+EOD
+$s16 << EOD
+1 8.5
+2 4.25
+3 3.166666667
+4 2.375
+6 1.916666667
+8 1.5625
+12 1.375
+16 1.21875
+24 1.145833333
+32 1.078125
+48 1.052083333
+64 1.0234375
+96 1.015625
+128 1.00390625
+192 1.002604167
+256 0.998046875
+EOD
+$s17 << EOD
+1 4
+2 2.333333333
+3 1.777777778
+4 1.666666667
+6 1.333333333
+8 1.25
+12 1.166666667
+16 1.125
+24 1.055555556
+32 1.0625
+48 1.027777778
+64 1.03125
+96 1.013888889
+128 1.010416667
+192 1.006944444
+243 0.9986282579
+EOD
+$s18 << EOD
+1 10.66666667
+2 5.333333333
+3 3.555555556
+4 3.166666667
+6 2.111111111
+8 1.833333333
+12 1.555555556
+16 1.416666667
+24 1.194444444
+32 1.208333333
+48 1.097222222
+64 1.104166667
+96 1.048611111
+128 1.036458333
+192 1.024305556
+243 0.9986282579
+EOD
+$s19 << EOD
+1 3.5
+2 2.1875
+3 1.75
+4 1.53125
+6 1.3125
+8 1.203125
+12 1.166666667
+16 1.09375
+24 1.057291667
+32 1.0390625
+48 1.020833333
+64 1.01171875
+96 1.01171875
+128 1.004882812
+192 1.002604167
+256 1.001464844
+384 1.000325521
+512 0.9997558594
+EOD
+$s20 << EOD
+1 21.875
+2 10.9375
+3 7.291666667
+4 5.46875
+6 3.645833333
+8 2.734375
+12 2.40625
+16 1.8046875
+24 1.494791667
+32 1.33984375
+48 1.184895833
+64 1.107421875
+96 1.102864583
+128 1.045898438
+192 1.025390625
+256 1.015136719
+384 1.004882812
+512 0.9997558594
+EOD
+set terminal pngcairo size 1920,480 noenhanced font 'sans,10'
 set output "traversed.png.tmp"
 set key top left box opaque
 set grid
-set multiplot layout 1,2
+set multiplot layout 1,3
 unset logscale
 set logscale x
 set logscale y
@@ -199,7 +311,7 @@ plot $s0 using 1:2 with linespoints pt 7 ps 0.8 title "objects traversed, n=2", 
      $s7 using 1:2 with lines lw 2 title "E[Eq. 8], n=8", \
      $s8 using 1:2 with linespoints pt 7 ps 0.8 title "intersection tests, n=8"
 unset logscale
-set title "Eqs. 5-7: C_{l1}/b with nothing hit"
+set title "Eqs. 5, 6: C_{l1}/b with nothing hit"
 set xlabel "l1"
 set ylabel "objects traversed / b"
 plot $s9 using 1:2 with linespoints pt 7 ps 0.8 title "measured, n=2", \
@@ -208,4 +320,16 @@ plot $s9 using 1:2 with linespoints pt 7 ps 0.8 title "measured, n=2", \
      $s12 using 1:2 with lines lw 2 title "Eq. 6 exact, n=3", \
      $s13 using 1:2 with linespoints pt 7 ps 0.8 title "measured, n=8", \
      $s14 using 1:2 with lines lw 2 title "Eq. 6 exact, n=8"
+unset logscale
+set logscale x
+set logscale y
+set title "Eq. 7: cost of a ray stopped by the i-th amalgam, over i C_b"
+set xlabel "i (amalgams of l1 reached)"
+set ylabel "measured cost / (i C_b)"
+plot $s15 using 1:2 with linespoints pt 7 ps 0.8 title "objects traversed, n=2", \
+     $s16 using 1:2 with linespoints pt 7 ps 0.8 title "intersection tests, n=2", \
+     $s17 using 1:2 with linespoints pt 7 ps 0.8 title "objects traversed, n=3", \
+     $s18 using 1:2 with linespoints pt 7 ps 0.8 title "intersection tests, n=3", \
+     $s19 using 1:2 with linespoints pt 7 ps 0.8 title "objects traversed, n=8", \
+     $s20 using 1:2 with linespoints pt 7 ps 0.8 title "intersection tests, n=8"
 unset multiplot

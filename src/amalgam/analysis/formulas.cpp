@@ -205,6 +205,28 @@ double eq7_linear_cost(int n, double i) {
   return i * c_b(n);
 }
 
+namespace {
+// sum_{k=0}^{l1} ceil(i / n^{l1 - k}): the level-k ancestors of the first i amalgams.
+double ancestors(int n, int l1, double i) {
+  require(n >= 2, "branching factor n must be >= 2");
+  require(l1 >= 0, "level must be >= 0");
+  require(i >= 1 && i <= std::pow(static_cast<double>(n), l1), "i must be in [1, n^l1]");
+  double sum = 0, w = 1;
+  for (int k = l1; k >= 0; --k, w *= n) sum += std::ceil(i / w);
+  return sum;
+}
+}  // namespace
+
+double objects_traversed_to(int n, int l1, double i) {
+  return ancestors(n, l1, i);
+}
+
+double tests_to(int n, int l1, double i) {
+  // Entered nodes are the ancestors on levels 0 .. l1 - 1 (all but the i on level l1); each
+  // tests its n children.
+  return 1.0 + n * (ancestors(n, l1, i) - std::ceil(i));
+}
+
 double eq8_cost(int n, double b, double i) {
   return std::max(eq4_lower_bound(n, b, i), eq7_linear_cost(n, i));
 }
@@ -323,14 +345,15 @@ double expected_eq8_cost(int n, std::uint64_t b, double p) {
 
 // --- Exact expected test counts of explicit traversals --------------------------------------
 
-double expected_tests_sorted(int n, int l1, double p) {
+double expected_tests_sorted(int n, int l1, double p, int m) {
   require(n >= 1, "branching factor n must be >= 1");
   require(l1 >= 0, "level must be >= 0");
   require(p >= 0.0, "p must be >= 0");
+  require(m >= 0, "failed objects m must be >= 0");
   double t = 0.0;  // t_{l1}
   for (int k = l1 - 1; k >= 0; --k) {
     const double mu_child = p / std::pow(static_cast<double>(n), k + 1);
-    t = n + t * siblings_processed(n, mu_child);
+    t = (n + m) + t * siblings_processed(n, mu_child);
   }
   return 1.0 + t;
 }
@@ -347,14 +370,15 @@ double expected_tests_sorted_lazy(int n, int l1, double p) {
   return 1.0 + t;
 }
 
-double expected_tests_traditional(int n, int l_max, double p) {
+double expected_tests_traditional(int n, int l_max, double p, int m) {
   require(n >= 1, "branching factor n must be >= 1");
   require(l_max >= 1, "l_max must be >= 1");
   require(p >= 0.0, "p must be >= 0");
-  double t = n;  // t_{l_max - 1}: a bottom node always tests all n primitives
+  require(m >= 0, "failed objects m must be >= 0");
+  double t = n + m;  // t_{l_max - 1}: a bottom node always tests all its n + m objects
   for (int k = l_max - 2; k >= 0; --k) {
     const double mu_child = p / std::pow(static_cast<double>(n), k + 1);
-    t = n + t * siblings_processed(n, mu_child);
+    t = (n + m) + t * siblings_processed(n, mu_child);
   }
   return 1.0 + t;
 }

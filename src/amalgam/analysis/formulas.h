@@ -136,6 +136,23 @@ double c_b_exact(int n, int l1);
 /// (accurate for large i). Requires n >= 2.
 double eq7_linear_cost(int n, double i);
 
+/// The exact cost, in objects traversed (Figure 4's counting: the root, each node reached in
+/// sorted order, the amalgams reached on level l_1), of a sorted traversal that stops at the
+/// i-th of the b = n^{l_1} amalgams on level l_1 when every amalgam lies on the ray:
+/// sum_{k=0}^{l_1} ceil(i / n^{l_1 - k}) (the level-k ancestors of the first i amalgams).
+/// It lies between i C_{l_1}/b and i C_{l_1}/b + l_1 + 1 (each ceiling adds less than one),
+/// so Eq. 7's i C_b is off by less than (l_1 + 1)/(i C_b) relatively: accurate for i >> l_1.
+/// i = 1 gives l_1 + 1 (Eq. 4, attained); i = b gives C_{l_1} (Eq. 5). Requires n >= 2,
+/// 1 <= i <= n^{l_1}.
+double objects_traversed_to(int n, int l1, double i);
+
+/// The same traversal counted as this renderer's intersection tests: the root's box, then
+/// all n children of every entered node, 1 + n sum_{k=0}^{l_1-1} ceil(i / n^{l_1 - k}).
+/// Within n l_1 + 1 of i C_{l_1}/b, so Eq. 7 holds for i >> n l_1 under this counting too;
+/// i = 1 gives 1 + n l_1, n times Eq. 4's l_1 + 1 for large l_1. Requires n >= 2,
+/// 1 <= i <= n^{l_1}.
+double tests_to(int n, int l1, double i);
+
 /// Eq. 8: the paper's overall cost of a traversal through i amalgams on level l_1,
 /// max(log_n b + i, i C_b) with C_b = n/(n - 1) from Eq. 6. Requires n >= 2, b >= 1.
 double eq8_cost(int n, double b, double i);
@@ -248,8 +265,9 @@ double expected_eq8_cost(int n, std::uint64_t b, double p);
 /// Checks: p = 0 gives 1 + n + ... + n^{l_1} = C_s0 (Eq. 1, the worst case); p -> infinity
 /// gives 1 + n l_1 (only the left edge is entered, all n children tested per level). The
 /// number of level-l_1 nodes processed follows exactly Eq. 9's distribution.
-/// Requires n >= 1, l_1 >= 0, p >= 0.
-double expected_tests_sorted(int n, int l1, double p);
+/// With m failed objects per node ("A Second Look": tested, never hit, never entered) every
+/// entered node costs n + m tests instead of n. Requires n >= 1, l_1 >= 0, p >= 0, m >= 0.
+double expected_tests_sorted(int n, int l1, double p, int m = 0);
 
 /// As expected_tests_sorted, but a child is tested only when the traversal reaches it
 /// (tested, then -- if above l_1 -- entered before the next sibling is tested); this is the
@@ -268,7 +286,8 @@ double expected_tests_sorted_lazy(int n, int l1, double p);
 /// with mu_{k+1} = p/n^{k+1}; a bottom node produces no hit with probability
 /// (1 - q)^n = e^{-p/n^{l_max-1}}. This coincides with expected_tests_sorted(n, l_max, p):
 /// the primitives play the role of level-l_1 units that cost nothing beyond the parent's n
-/// tests. p = 0 gives C_t0. Requires n >= 1, l_max >= 1, p >= 0.
-double expected_tests_traditional(int n, int l_max, double p);
+/// tests. p = 0 gives C_t0. With m failed objects per node every entered node (a bottom one
+/// too) costs n + m tests. Requires n >= 1, l_max >= 1, p >= 0, m >= 0.
+double expected_tests_traditional(int n, int l_max, double p, int m = 0);
 
 }  // namespace amalgam::formulas
