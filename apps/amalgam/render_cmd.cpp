@@ -9,6 +9,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <optional>
@@ -32,6 +33,7 @@
 #include "mpi_render.h"
 #endif
 #include "progress.h"
+#include "render_setup.h"
 
 namespace amalgam::cli {
 
@@ -72,189 +74,231 @@ const char* signal_name(int sig) {
   }
 }
 
-/// The --footprint value of `lod` (1, the default, where there is none), as fingerprints and
-/// the EXR header spell it.
-float footprint_of(const LevelOfDetail& lod) {
-  if (const auto* f = std::get_if<ByFootprint>(&lod)) return f->pixels;
-  if (const auto* c = std::get_if<VolumetricCells>(&lod)) return c->cone_widths;
-  return 1.0f;
-}
-
-/// Everything that determines the image except spp and threads: the renderer options and the
-/// scene as loaded (content_hash: its geometry, lights and camera, or a builtin's parameters
-/// as applied). A checkpoint is only resumed under the same fingerprint.
-std::string fingerprint(const CommonOptions& c, const LoadedScene& scene) {
-  const RenderOptions& o = c.options;
-  std::ostringstream f;
-  f << c.scene << " (scene " << std::hex << content_hash(scene) << std::dec << ")"
-    << " --renderer " << c.renderer << " --opacity " << c.opacity << " --order " << c.order
-    << " --seed " << o.seed << " --width " << o.width << " --height " << o.height;
-  if (const auto* l = std::get_if<OnLevel>(&o.lod))
-    f << " --level " << l->level;
-  else
-    f << " --footprint " << footprint_of(o.lod);
-  if (o.tracer == TracerKind::kEmbree) f << " --tracer embree";  // amalgam's: as before
-  // Only when not the default, so checkpoints written before the option existed still resume.
-  if (o.sampler == PixelSampler::kStratified) f << " --sampler stratified";
-  return f.str();
-}
-
-/// Checks every output path before any work: an image path must name a format we write, every
-/// path must be writable, no two outputs may be the same file and none may be the scene file
-/// (compared by file identity: device and inode, or the resolved path of a new file). Throws
-/// InputError.
-struct Output {
-  const char* option;
-  const std::string& path;
+/// What a render needs once its options, outputs and scene are checked.
+struct Prepared {
+  std::optional<LogRange> given_range;
+  std::optional<LoadedScene> loaded;
+  std::string fp;   ///< fingerprint(): a checkpoint resumes only under the same
+  FilmState state;  ///< the checkpoint resumed (rank 0), or empty
+  std::unique_ptr<Tracer> tracer;
 };
 
-/// The files a render writes, by option (an empty path: not written).
-std::array<Output, 5> outputs(const RenderExtras& e, const std::string& ckpt) {
-  return {{{"--out", e.out},
-           {"--cost-image", e.cost_image},
-           {"--level-image", e.level_image},
-           {"--stats", e.stats},
-           {"--checkpoint", ckpt}}};
-}
+/// Checks the options and the outputs (rank 0's), loads the scene within the memory budget,
+/// builds its tracer and reads the checkpoint to resume. Throws InputError.
+void prepare(CommonOptions& common, const RenderExtras& extra, const std::string& ckpt, bool root,
+             Prepared& p) {
+  const RenderOptions& o = common.options;
+  common.finish();
+  if (!extra.cost_range.empty()) p.given_range = parse_cost_range(extra.cost_range);
+  // A checkpoint to resume must be a regular file: known before any work (read_checkpoint
+  // refuses it too, without opening a FIFO for reading, which would wait for a writer).
+  if (extra.resume && root)
+    if (const std::string why = not_a_regular_file(ckpt); !why.empty())
+      throw InputError(ckpt + ": " + why + ": cannot resume from it");
+  if (root) check_outputs(extra, ckpt, o, common.scene);  // the outputs are rank 0's
+  const std::uint64_t asked =
+      extra.max_memory_given ? parse_bytes(extra.max_memory, "--max-memory") : 0;
+  if (extra.max_memory_given && asked == 0)
+    throw InputError("--max-memory 0: expected a positive byte count");
+  const std::uint64_t limit = asked ? asked : physical_memory();
+  const std::uint64_t film = film_bytes(o);
+  if (film > limit)
+    throw InputError("--width " + std::to_string(o.width) + " --height " +
+                     std::to_string(o.height) + ": the film needs " + format_bytes(film) +
+                     ", more than --max-memory " + format_bytes(limit));
+  set_activity("loading and building " + common.scene);
+  PhaseStatus status(!extra.quiet);
+  SceneFileConfig budget;  // checked before the scene is built (MemoryModel)
+  budget.max_bytes = limit - film;
+  budget.limit_name = "--max-memory " + format_bytes(static_cast<double>(limit)) + " less " +
+                      format_bytes(static_cast<double>(film)) + " for the film";
+  budget.import_max_bytes = limit;
+  budget.import_limit_name = "--max-memory " + format_bytes(static_cast<double>(limit));
+  budget.objects = o.renderer() == RendererKind::kVolumetric;
+  budget.smooth_normals = common.smooth_normals;
+  budget.on_phase = [&](const std::string& what) {
+    set_activity(what);
+    status.phase(what);
+  };
+  p.loaded.emplace(load_scene(common.scene, common.params(), budget));
+  if (root) check_outputs_spare_inputs(extra, ckpt, *p.loaded);
+  common.prepare(*p.loaded);  // the view options, before the fingerprint takes the camera
+  if (o.tracer == TracerKind::kEmbree) {
+    set_activity("building Embree's BVH of " + common.scene);
+    status.phase(activity());
+  }
+  p.tracer = make_tracer(*p.loaded, o);  // checks the options against the scene first
+  status.stop();
+  if (root) print_warnings(*p.loaded);  // after the load phases' status line
 
-/// Once the scene is loaded, before anything is written: no output on a file it read (the
-/// meshes a scene file names and the textures they name; the scene file itself was checked
-/// before loading). Throws InputError.
-void check_outputs_spare_inputs(const RenderExtras& e, const std::string& ckpt,
-                                const LoadedScene& scene) {
-  std::vector<std::pair<std::string, const std::string*>> inputs;  // by identity
-  for (const std::string& in : scene.inputs) inputs.emplace_back(file_identity(in), &in);
-  for (const Output& o : outputs(e, ckpt)) {
-    if (o.path.empty() || resolve_output(o.path).kind != OutputTarget::Kind::kFile) continue;
-    const std::string key = file_identity(o.path);
-    for (const auto& [identity, path] : inputs)
-      if (identity == key)
-        throw InputError(std::string(o.option) + " " + o.path + ": " + *path +
-                         ", which the scene " + scene.name +
-                         " reads (an output never replaces an input)");
+  p.fp = fingerprint(common, *p.loaded);
+  if (extra.resume && root) {
+    if (!std::filesystem::exists(ckpt)) throw InputError(ckpt + ": no checkpoint to resume from");
+    p.state = read_checkpoint(ckpt, p.fp);
+    if (p.state.spp_done > o.spp)
+      throw InputError(ckpt + ": checkpoint holds " + std::to_string(p.state.spp_done) +
+                       " samples per pixel, more than --spp " + std::to_string(o.spp));
   }
 }
 
-void check_outputs(const RenderExtras& e, const std::string& ckpt, const RenderOptions& ro,
-                   const std::string& scene) {
-  if (!e.cost_image.empty() && ro.tracer == TracerKind::kEmbree)
-    throw InputError("--cost-image " + e.cost_image +
-                     ": --tracer embree counts no intersection tests (no cost image)");
-  if (!is_image_path(e.out))
-    throw InputError("--out " + e.out + ": unsupported image format (expected .png, .exr or .pfm)");
-  if (!e.cost_image.empty() && !is_image_path(e.cost_image))
-    throw InputError("--cost-image " + e.cost_image +
-                     ": unsupported image format (expected .png, .exr or .pfm)");
-  if (!e.level_image.empty() && !is_image_path(e.level_image))
-    throw InputError("--level-image " + e.level_image +
-                     ": unsupported image format (expected .png, .exr or .pfm)");
-  std::error_code ec;
-  const bool scene_file = scene.rfind("builtin:", 0) != 0 && std::filesystem::exists(scene, ec);
-  const std::string input = scene_file ? file_identity(scene) : std::string();
-  std::vector<std::pair<std::string, const char*>> files;  // regular files, by identity
-  for (const Output& o : outputs(e, ckpt)) {
-    if (o.path.empty()) continue;
-    check_writable(o.path);
-    const OutputTarget t = resolve_output(o.path);
-    if (t.kind != OutputTarget::Kind::kFile) continue;  // devices and "-" may be shared
-    const std::string key = file_identity(o.path);
-    if (key == input)
-      throw InputError(std::string(o.option) + " " + o.path + ": the scene " + scene +
-                       " itself (an output never replaces an input)");
-    for (const auto& [other, option] : files)
-      if (other == key)
-        throw InputError(std::string(o.option) + " " + o.path + ": the same file as " + option);
-    files.emplace_back(key, o.option);
+/// SIGHUP (a closed terminal, a dropped SSH session) and SIGQUIT stop the render as SIGINT and
+/// SIGTERM do. A signal ignored at start stays ignored: nohup ignores SIGHUP, and a shell
+/// ignores SIGINT and SIGQUIT in the background jobs it starts, so they outlive a Ctrl-C.
+void catch_stop_signals() {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  for (const int sig : kStopSignals) {
+    struct sigaction old {};
+    if (sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    sigaction(sig, &sa, nullptr);
   }
 }
 
-std::uint64_t physical_memory() {
-  return static_cast<std::uint64_t>(sysconf(_SC_PHYS_PAGES)) *
-         static_cast<std::uint64_t>(sysconf(_SC_PAGE_SIZE));
-}
-
-/// Bytes a render of these options needs beyond the scene: the process and the film (sums,
-/// tests, image and cost per pixel; MemoryModel, hierarchy/build/build.h).
-std::uint64_t film_bytes(const RenderOptions& o) {
-  const std::uint64_t pixels = static_cast<std::uint64_t>(o.width) * o.height;
-  return MemoryModel::kProcess + pixels * MemoryModel::kPerPixel;
-}
-
-/// "--cost-range MIN,MAX": two finite numbers, 0 < MIN < MAX (a log scale). Throws InputError.
-LogRange parse_cost_range(const std::string& text) {
-  const std::string what = "--cost-range " + text + ": ";
-  const std::size_t comma = text.find(',');
-  if (comma == std::string::npos)
-    throw InputError(what + "expected two numbers MIN,MAX (e.g. 10,1000)");
-  double v[2];
-  const std::string parts[2] = {text.substr(0, comma), text.substr(comma + 1)};
-  for (int k = 0; k < 2; ++k) {
-    std::size_t end = 0;
+/// Writes the image, the cost and level images, the stats and, when the render was interrupted
+/// or an output failed, the checkpoint. Each output is written even when another fails; returns
+/// false, with each failure and the list of the outputs not written printed, if any failed.
+bool write_outputs(const CommonOptions& common, const RenderExtras& extra, const std::string& ckpt,
+                   const Prepared& p, const RenderOutput& r, const LogRange& range, int ranks) {
+  const RenderOptions& o = common.options;
+  std::vector<std::string> failed;
+  auto attempt = [&](const std::string& what, auto&& write) {
     try {
-      v[k] = std::stod(parts[k], &end);
-    } catch (const std::exception&) {
-      end = 0;
+      write();
+    } catch (const std::exception& e) {
+      std::cerr << "amalgam: " << e.what() << "\n";
+      failed.push_back(what);
     }
-    if (parts[k].empty() || end != parts[k].size() || !std::isfinite(v[k]))
-      throw InputError(what + "expected two numbers MIN,MAX (e.g. 10,1000)");
+  };
+  const int max_level = p.loaded->info().levels - 1;
+  if (r.spp > 0) {
+    attempt(extra.out, [&] {
+      if (is_exr_path(extra.out)) {
+        const double top = write_render_exr(
+            extra.out, r,
+            {{"amalgam:command", command_text(extra.argv)},
+             {"amalgam:version", version()},
+             {"amalgam:scene", common.scene},
+             {"amalgam:seed", std::to_string(o.seed)},
+             {"amalgam:spp", std::to_string(r.spp)},
+             {"amalgam:options", options_text(common, r.spp)},
+             {"amalgam:cost", "cost.Y: intersection tests per pixel, total over its spp samples"},
+             {"amalgam:level", "level.Y: level of the rendered amalgams (majority of samples); " +
+                                   std::to_string(kLevelPrimitive) + ": primitives; " +
+                                   std::to_string(kLevelNothing) + ": nothing hit"}},
+            p.tracer->counts_tests());
+        if (top > 16777216.0)
+          std::cerr << "amalgam: warning: " << extra.out << ": a pixel holds " << top
+                    << " tests, beyond 2^24: its cost.Y is rounded to float32 (the stats JSON "
+                       "is exact)\n";
+      } else {
+        write_image(extra.out, r.width, r.height, r.image);
+      }
+    });
+    if (!extra.cost_image.empty())
+      attempt(extra.cost_image, [&] { write_cost_image(extra.cost_image, r, range); });
+    if (!extra.level_image.empty())
+      attempt(extra.level_image, [&] { write_level_image(extra.level_image, r, max_level); });
   }
-  if (!(v[0] > 0.0))
-    throw InputError(what + "MIN must be greater than 0 on the log scale of the cost image");
-  if (!(v[0] < v[1])) throw InputError(what + "MIN must be less than MAX");
-  return {v[0], v[1]};
+  nlohmann::json stats =
+      stats_json(*p.loaded, o, r.counters, r.per_primary, r.seconds, p.tracer->build_seconds());
+  RunInfo run;
+  run.argv = extra.argv;
+  run.width = r.width;
+  run.height = r.height;
+  run.spp = r.spp;
+  run.threads = render_threads(o);
+  run.ranks = ranks;
+  run.peak_memory_bytes = peak_memory_bytes();
+  run.cost_range = range;
+  add_run_info(stats, run);
+  const std::string json = stats.dump(2) + "\n";
+  if (!extra.stats.empty()) attempt(extra.stats, [&] { write_file_atomic(extra.stats, json); });
+  if (r.interrupted || !failed.empty())
+    attempt(ckpt, [&] { write_checkpoint(ckpt, p.fp, p.state); });
+  if (failed.empty()) return true;
+  std::cerr << "amalgam: not written: ";
+  for (std::size_t i = 0; i < failed.size(); ++i) std::cerr << (i ? ", " : "") << failed[i];
+  std::cerr << "\n";
+  return false;
 }
 
-/// The command line as one string, each argument that needs it in single quotes, without
-/// --threads: it goes into the EXR header, which is part of the file's bytes, and those are the
-/// same for any thread count (the stats hold the threads used).
-std::string command_text(const std::vector<std::string>& argv) {
-  std::string out;
-  for (std::size_t i = 0; i < argv.size(); ++i) {
-    const std::string& a = argv[i];
-    if (i > 0 && a == "--threads") {
-      ++i;  // and its value
-      continue;
-    }
-    if (a.starts_with("--threads=")) continue;
-    if (!out.empty()) out += ' ';
-    const bool plain = !a.empty() && a.find_first_not_of(
-                                         "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMN"
-                                         "OPQRSTUVWXYZ0123456789-_.,:/=+@%") == std::string::npos;
-    if (plain) {
-      out += a;
-      continue;
-    }
-    out += '\'';
-    for (char c : a) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    out += '\'';
+/// A complete render: the checkpoint is no longer needed, and (unless --quiet) what was written
+/// is said. What is removed is the file the checkpoint was written to: through a symbolic link,
+/// its target (the link is the user's and stays); a device or FIFO is never removed.
+void finish_complete(const RenderExtras& extra, const std::string& ckpt, const Prepared& p,
+                     const RenderOutput& r, const LogRange& range) {
+  try {
+    const OutputTarget t = resolve_output(ckpt);
+    std::error_code ec;
+    if (t.kind == OutputTarget::Kind::kFile && std::filesystem::is_regular_file(t.path, ec))
+      std::filesystem::remove(t.path, ec);
+  } catch (const InputError&) {  // its directory went away meanwhile: nothing to remove
   }
-  return out;
+  if (extra.quiet) return;
+  std::cerr << "amalgam: wrote " << extra.out << " (" << r.width << "x" << r.height << ", " << r.spp
+            << " spp, " << r.seconds << " s, ";
+  if (!p.tracer->counts_tests())
+    std::cerr << "Embree, BVH build " << p.tracer->build_seconds() << " s)\n";
+  else
+    std::cerr << r.per_primary.mean() << " tests per primary ray)\n";
+  if (!extra.cost_image.empty() && is_png_path(extra.cost_image))
+    std::cerr << "amalgam: cost image " << extra.cost_image << ": viridis, log scale "
+              << format_range(range) << " tests per primary sample (colour bar along the bottom)\n";
+  if (!extra.level_image.empty() && is_png_path(extra.level_image))
+    std::cerr << "amalgam: level image " << extra.level_image << ": viridis from level 0 to "
+              << p.loaded->info().levels - 1 << "; light grey: primitives; black: nothing hit\n";
 }
 
-/// The renderer options as command-line text (the EXR header's "amalgam:options").
-std::string options_text(const CommonOptions& c, int spp) {
-  const RenderOptions& o = c.options;
-  std::ostringstream f;
-  f << "--renderer " << c.renderer << " --opacity " << c.opacity << " --order " << c.order;
-  if (const auto* l = std::get_if<OnLevel>(&o.lod))
-    f << " --level " << l->level;
-  else if (o.renderer() != RendererKind::kTraditional)
-    f << " --footprint " << footprint_of(o.lod);
-  f << " --seed " << o.seed << " --width " << o.width << " --height " << o.height << " --spp "
-    << spp;
-  return f.str();
+#if defined(AMALGAM_HAVE_MPI)
+/// In a parallel render, once every rank has prepared: whether one failed, then whether every
+/// rank loaded the same scene and options as rank 0 (the same fingerprint). Returns the exit
+/// status to end with, or 0 to render.
+int agree_to_render(const std::exception_ptr& failure, const std::string& scene,
+                    const std::string& fp) {
+  if (const int st = mpi::agree(failure)) return st;
+  const std::string root_fp = mpi::broadcast(fp);
+  std::exception_ptr differs;
+  if (root_fp != fp)
+    differs = std::make_exception_ptr(
+        InputError(scene + ": this rank loads a different scene or options than rank 0 (" + fp +
+                   " against " + root_fp + ")"));
+  return mpi::agree(differs);
+}
+#endif
+
+/// Says that signal `sig` (on rank `where`) stopped the render, what the image holds and how to
+/// continue from the checkpoint.
+void say_interrupted(const RenderExtras& extra, int spp_asked, const std::string& ckpt,
+                     const RenderOutput& r, int sig, const std::string& where) {
+  std::cerr << "amalgam: interrupted by " << signal_name(sig) << where << ": "
+            << (r.spp > 0 ? extra.out : std::string("no image")) << " holds " << r.spp << " of "
+            << spp_asked << " samples per pixel; checkpoint " << ckpt
+            << " (continue with the same command and --resume)\n";
 }
 
-std::uint64_t peak_memory_bytes() {
-  rusage u{};
-  if (getrusage(RUSAGE_SELF, &u) != 0) return 0;
-  return static_cast<std::uint64_t>(u.ru_maxrss) * 1024;  // Linux: kibibytes
-}
-
-std::string format_range(const LogRange& r) {
-  std::ostringstream s;
-  s << r.min << ".." << r.max;
-  return s.str();
+/// Runs `render` with a progress line and a checkpoint every --checkpoint-every seconds (at
+/// the end of the pass that crosses it), stopping at the next tile on a stop signal.
+RenderOutput render_with_progress(const RenderOptions& o, const RenderExtras& extra,
+                                  const std::string& ckpt, const Prepared& p,
+                                  const std::function<RenderOutput(const RenderControl&)>& render) {
+  Progress progress(o.spp, !extra.quiet);
+  auto last_checkpoint = std::chrono::steady_clock::now();
+  RenderControl control;
+  control.cancel = &g_cancel;
+  control.on_pass = [&](const FilmState& st) {
+    progress.update(st.spp_done);
+    const auto now = std::chrono::steady_clock::now();
+    if (st.spp_done < o.spp &&
+        std::chrono::duration<double>(now - last_checkpoint).count() >= extra.checkpoint_every) {
+      write_checkpoint(ckpt, p.fp, st);  // survives even a SIGKILL
+      last_checkpoint = now;
+    }
+  };
+  RenderOutput r = render(control);
+  progress.finish();
+  return r;
 }
 
 }  // namespace
@@ -272,102 +316,26 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
   if (!root) extra.quiet = true;  // rank 0 speaks for the job
   const RenderOptions& o = common.options;
   const std::string ckpt = extra.checkpoint.empty() ? extra.out + ".ckpt" : extra.checkpoint;
-  std::optional<LogRange> given_range;
-  std::optional<LoadedScene> loaded;
-  std::string fp;
-  FilmState state;
-  std::unique_ptr<Tracer> tracer;
+  Prepared p;
   // In a parallel render every rank prepares (options, scene) before any renders, and a rank
   // that fails tells the others (mpi::agree) rather than leaving them waiting.
   std::exception_ptr failure;
   try {
-    common.finish();
-    if (!extra.cost_range.empty()) given_range = parse_cost_range(extra.cost_range);
-    // A checkpoint to resume must be a regular file: known before any work (read_checkpoint
-    // refuses it too, without opening a FIFO for reading, which would wait for a writer).
-    if (extra.resume && root)
-      if (const std::string why = not_a_regular_file(ckpt); !why.empty())
-        throw InputError(ckpt + ": " + why + ": cannot resume from it");
-    if (root) check_outputs(extra, ckpt, o, common.scene);  // the outputs are rank 0's
-    const std::uint64_t asked =
-        extra.max_memory_given ? parse_bytes(extra.max_memory, "--max-memory") : 0;
-    if (extra.max_memory_given && asked == 0)
-      throw InputError("--max-memory 0: expected a positive byte count");
-    const std::uint64_t limit = asked ? asked : physical_memory();
-    const std::uint64_t film = film_bytes(o);
-    if (film > limit)
-      throw InputError("--width " + std::to_string(o.width) + " --height " +
-                       std::to_string(o.height) + ": the film needs " + format_bytes(film) +
-                       ", more than --max-memory " + format_bytes(limit));
-    set_activity("loading and building " + common.scene);
-    PhaseStatus status(!extra.quiet);
-    SceneFileConfig budget;  // checked before the scene is built (MemoryModel)
-    budget.max_bytes = limit - film;
-    budget.limit_name = "--max-memory " + format_bytes(static_cast<double>(limit)) + " less " +
-                        format_bytes(static_cast<double>(film)) + " for the film";
-    budget.import_max_bytes = limit;
-    budget.import_limit_name = "--max-memory " + format_bytes(static_cast<double>(limit));
-    budget.objects = o.renderer() == RendererKind::kVolumetric;
-    budget.smooth_normals = common.smooth_normals;
-    budget.on_phase = [&](const std::string& what) {
-      set_activity(what);
-      status.phase(what);
-    };
-    loaded.emplace(load_scene(common.scene, common.params(), budget));
-    if (root) check_outputs_spare_inputs(extra, ckpt, *loaded);
-    common.prepare(*loaded);  // the view options, before the fingerprint takes the camera
-    if (o.tracer == TracerKind::kEmbree) {
-      set_activity("building Embree's BVH of " + common.scene);
-      status.phase(activity());
-    }
-    tracer = make_tracer(*loaded, o);  // checks the options against the scene first
-    status.stop();
-    if (root) print_warnings(*loaded);  // after the load phases' status line
-
-    fp = fingerprint(common, *loaded);
-    if (extra.resume && root) {
-      if (!std::filesystem::exists(ckpt)) throw InputError(ckpt + ": no checkpoint to resume from");
-      state = read_checkpoint(ckpt, fp);
-      if (state.spp_done > o.spp)
-        throw InputError(ckpt + ": checkpoint holds " + std::to_string(state.spp_done) +
-                         " samples per pixel, more than --spp " + std::to_string(o.spp));
-    }
+    prepare(common, extra, ckpt, root, p);
   } catch (...) {
     if (!parallel) throw;
     failure = std::current_exception();
   }
 #if defined(AMALGAM_HAVE_MPI)
-  if (parallel) {
-    if (const int st = mpi::agree(failure)) return st;
-    // Every rank must render the same image: the same scene (content hash) and options.
-    const std::string root_fp = mpi::broadcast(fp);
-    failure = nullptr;
-    if (root_fp != fp)
-      failure = std::make_exception_ptr(
-          InputError(common.scene + ": this rank loads a different scene or options than rank 0 (" +
-                     fp + " against " + root_fp + ")"));
-    if (const int st = mpi::agree(failure)) return st;
-  }
+  if (parallel)
+    if (const int st = agree_to_render(failure, common.scene, p.fp)) return st;
 #endif
-  const LoadedScene& scene = *loaded;
-
-  // SIGHUP (a closed terminal, a dropped SSH session) and SIGQUIT stop the render as SIGINT and
-  // SIGTERM do. A signal ignored at start stays ignored: nohup ignores SIGHUP, and a shell
-  // ignores SIGINT and SIGQUIT in the background jobs it starts, so they outlive a Ctrl-C.
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sa.sa_flags = SA_RESTART;
-  for (const int sig : kStopSignals) {
-    struct sigaction old {};
-    if (sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
-    sigaction(sig, &sa, nullptr);
-  }
+  catch_stop_signals();
 #if defined(AMALGAM_HAVE_MPI)
   // What renders a tile on this rank: amalgam's traversal or Embree, as for one process.
   const mpi::TileRenderer tile_renderer = [&](FilmTile& t, int s0, int s1,
                                               const std::atomic<bool>* cancel) {
-    return tracer->render_tile(o, t, s0, s1, cancel);
+    return p.tracer->render_tile(o, t, s0, s1, cancel);
   };
   if (!root) {
     mpi::serve(tile_renderer, o, g_cancel, g_signal);
@@ -383,97 +351,22 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
   } release{parallel};
   mpi::Stop stop;
 #endif
-  Progress progress(o.spp, !extra.quiet);
-  auto last_checkpoint = std::chrono::steady_clock::now();
-  RenderControl control;
-  control.cancel = &g_cancel;
-  control.on_pass = [&](const FilmState& st) {
-    progress.update(st.spp_done);
-    const auto now = std::chrono::steady_clock::now();
-    if (st.spp_done < o.spp &&
-        std::chrono::duration<double>(now - last_checkpoint).count() >= extra.checkpoint_every) {
-      write_checkpoint(ckpt, fp, st);  // survives even a SIGKILL
-      last_checkpoint = now;
-    }
-  };
   set_activity("rendering " + common.scene);
-  RenderOutput r;
+  const RenderOutput r = render_with_progress(o, extra, ckpt, p, [&](const RenderControl& control) {
 #if defined(AMALGAM_HAVE_MPI)
-  if (parallel) {
     // Rounds as long as the checkpoint interval: a checkpoint is written at the end of one.
-    r = mpi::render_root(tile_renderer, o, &state, control, g_signal, extra.rank_timeout,
-                         extra.checkpoint_every, stop);
-  }
+    if (parallel)
+      return mpi::render_root(tile_renderer, o, &p.state, control, g_signal, extra.rank_timeout,
+                              extra.checkpoint_every, stop);
 #endif
-  if (!parallel) r = tracer->render(o, &state, control);
-  const double embree_build = tracer->build_seconds();
-  progress.finish();
+    return p.tracer->render(o, &p.state, control);
+  });
   set_activity("writing the outputs of " + common.scene);
   // The work is done: writing its results wins over further signals (on_signal).
   g_finishing.store(true);
 
-  // Each output is written even when another fails; the ones missing are named at the end.
-  std::vector<std::string> failed;
-  auto attempt = [&](const std::string& what, auto&& write) {
-    try {
-      write();
-    } catch (const std::exception& e) {
-      std::cerr << "amalgam: " << e.what() << "\n";
-      failed.push_back(what);
-    }
-  };
-  const LogRange range = given_range ? *given_range : own_range(r.cost);
-  const int max_level = scene.info().levels - 1;
-  if (r.spp > 0) {
-    attempt(extra.out, [&] {
-      if (is_exr_path(extra.out)) {
-        const double top = write_render_exr(
-            extra.out, r,
-            {{"amalgam:command", command_text(extra.argv)},
-             {"amalgam:version", version()},
-             {"amalgam:scene", common.scene},
-             {"amalgam:seed", std::to_string(o.seed)},
-             {"amalgam:spp", std::to_string(r.spp)},
-             {"amalgam:options", options_text(common, r.spp)},
-             {"amalgam:cost", "cost.Y: intersection tests per pixel, total over its spp samples"},
-             {"amalgam:level", "level.Y: level of the rendered amalgams (majority of samples); " +
-                                   std::to_string(kLevelPrimitive) + ": primitives; " +
-                                   std::to_string(kLevelNothing) + ": nothing hit"}},
-            tracer->counts_tests());
-        if (top > 16777216.0)
-          std::cerr << "amalgam: warning: " << extra.out << ": a pixel holds " << top
-                    << " tests, beyond 2^24: its cost.Y is rounded to float32 (the stats JSON "
-                       "is exact)\n";
-      } else {
-        write_image(extra.out, r.width, r.height, r.image);
-      }
-    });
-    if (!extra.cost_image.empty())
-      attempt(extra.cost_image, [&] { write_cost_image(extra.cost_image, r, range); });
-    if (!extra.level_image.empty())
-      attempt(extra.level_image, [&] { write_level_image(extra.level_image, r, max_level); });
-  }
-  nlohmann::json stats = stats_json(scene, o, r.counters, r.per_primary, r.seconds, embree_build);
-  RunInfo run;
-  run.argv = extra.argv;
-  run.width = r.width;
-  run.height = r.height;
-  run.spp = r.spp;
-  run.threads = render_threads(o);
-  run.ranks = ranks;
-  run.peak_memory_bytes = peak_memory_bytes();
-  run.cost_range = range;
-  add_run_info(stats, run);
-  const std::string json = stats.dump(2) + "\n";
-  if (!extra.stats.empty()) attempt(extra.stats, [&] { write_file_atomic(extra.stats, json); });
-  if (r.interrupted || !failed.empty()) attempt(ckpt, [&] { write_checkpoint(ckpt, fp, state); });
-  if (!failed.empty()) {
-    std::cerr << "amalgam: not written: ";
-    for (std::size_t i = 0; i < failed.size(); ++i) std::cerr << (i ? ", " : "") << failed[i];
-    std::cerr << "\n";
-    return 1;
-  }
-
+  const LogRange range = p.given_range ? *p.given_range : own_range(r.cost);
+  if (!write_outputs(common, extra, ckpt, p, r, range, ranks)) return 1;
   if (r.interrupted) {
     int sig = g_signal.load();
     std::string where;
@@ -484,37 +377,10 @@ int run_render(CommonOptions& common, const RenderExtras& given) {
       if (!stop.missing.empty()) std::cerr << "amalgam: " << stop.missing << "\n";
     }
 #endif
-    std::cerr << "amalgam: interrupted by " << signal_name(sig) << where << ": "
-              << (r.spp > 0 ? extra.out : std::string("no image")) << " holds " << r.spp << " of "
-              << o.spp << " samples per pixel; checkpoint " << ckpt
-              << " (continue with the same command and --resume)\n";
+    say_interrupted(extra, o.spp, ckpt, r, sig, where);
     return 1;
   }
-  // Complete: the checkpoint is no longer needed. What is removed is the file it was written to:
-  // through a symbolic link, its target (the link is the user's and stays); a device or FIFO
-  // is never removed.
-  try {
-    const OutputTarget t = resolve_output(ckpt);
-    std::error_code ec;
-    if (t.kind == OutputTarget::Kind::kFile && std::filesystem::is_regular_file(t.path, ec))
-      std::filesystem::remove(t.path, ec);
-  } catch (const InputError&) {  // its directory went away meanwhile: nothing to remove
-  }
-  if (!extra.quiet) {
-    std::cerr << "amalgam: wrote " << extra.out << " (" << r.width << "x" << r.height << ", "
-              << r.spp << " spp, " << r.seconds << " s, ";
-    if (!tracer->counts_tests())
-      std::cerr << "Embree, BVH build " << embree_build << " s)\n";
-    else
-      std::cerr << r.per_primary.mean() << " tests per primary ray)\n";
-    if (!extra.cost_image.empty() && is_png_path(extra.cost_image))
-      std::cerr << "amalgam: cost image " << extra.cost_image << ": viridis, log scale "
-                << format_range(range)
-                << " tests per primary sample (colour bar along the bottom)\n";
-    if (!extra.level_image.empty() && is_png_path(extra.level_image))
-      std::cerr << "amalgam: level image " << extra.level_image << ": viridis from level 0 to "
-                << max_level << "; light grey: primitives; black: nothing hit\n";
-  }
+  finish_complete(extra, ckpt, p, r, range);
   return 0;
 }
 

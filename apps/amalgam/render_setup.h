@@ -1,0 +1,58 @@
+#pragma once
+/// \file What `amalgam render` checks and records around a render: its output paths, its
+/// memory budget, the fingerprint a checkpoint is resumed under, and the command-line text of
+/// the EXR header (render_cmd.cpp runs the render itself).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "amalgam/io/colormap.h"
+#include "amalgam/load/load_scene.h"
+#include "common.h"
+
+namespace amalgam::cli {
+
+/// Everything that determines the image except spp and threads: the renderer options and the
+/// scene as loaded (content_hash: its geometry, lights and camera, or a builtin's parameters
+/// as applied). A checkpoint is only resumed under the same fingerprint.
+std::string fingerprint(const CommonOptions& c, const LoadedScene& scene);
+
+/// Checks every output path before any work: an image path must name a format we write, every
+/// path must be writable, no two outputs may be the same file and none may be the scene file
+/// (compared by file identity: device and inode, or the resolved path of a new file). Throws
+/// InputError.
+void check_outputs(const RenderExtras& e, const std::string& ckpt, const RenderOptions& ro,
+                   const std::string& scene);
+
+/// Once the scene is loaded, before anything is written: no output on a file it read (the
+/// meshes a scene file names and the textures they name; the scene file itself was checked
+/// before loading). Throws InputError.
+void check_outputs_spare_inputs(const RenderExtras& e, const std::string& ckpt,
+                                const LoadedScene& scene);
+
+/// The machine's physical memory in bytes (the default --max-memory).
+std::uint64_t physical_memory();
+
+/// Bytes a render of these options needs beyond the scene: the process and the film (sums,
+/// tests, image and cost per pixel; MemoryModel, hierarchy/build/build.h).
+std::uint64_t film_bytes(const RenderOptions& o);
+
+/// "--cost-range MIN,MAX": two finite numbers, 0 < MIN < MAX (a log scale). Throws InputError.
+LogRange parse_cost_range(const std::string& text);
+
+/// The command line as one string, each argument that needs it in single quotes, without
+/// --threads: it goes into the EXR header, which is part of the file's bytes, and those are the
+/// same for any thread count (the stats hold the threads used).
+std::string command_text(const std::vector<std::string>& argv);
+
+/// The renderer options as command-line text (the EXR header's "amalgam:options").
+std::string options_text(const CommonOptions& c, int spp);
+
+/// The process's peak resident memory in bytes (0 where unknown).
+std::uint64_t peak_memory_bytes();
+
+/// "MIN..MAX", as the messages print a cost range.
+std::string format_range(const LogRange& r);
+
+}  // namespace amalgam::cli
