@@ -22,6 +22,33 @@ std::vector<double> widen(ExperimentResult& r, std::initializer_list<const char*
   return std::vector<double>(r.table.columns.size(), NAN);
 }
 
+/// Worst-case secondary rays with m failed objects per node on builtin:line: the traditional
+/// renderer (l_max = l) and the stochastic one (l1 = l, one level more below); the shadow ray
+/// from the hit back to the light crosses the whole line, as the primary ray did.
+void worst_secondary(const Config& c, ExperimentResult& r, const std::vector<double>& blank, int n,
+                     int m, int l) {
+  const std::string at = "n=" + str(n) + " m=" + str(m) + " l=" + str(l);
+  const auto col = [&](const char* name) { return r.table.col(name); };
+  for (int renderer = 0; renderer < 2; ++renderer) {
+    const LoadedScene sc =
+        scene("line", {{"n", str(n)}, {"depth", str(renderer == 0 ? l : l + 1)}, {"m", str(m)}});
+    const TraceOutput t = trace_centre(sc, renderer == 0 ? traditional() : at_level(l));
+    const double prim = u(t.counters.tests_of(RayKind::kPrimary));
+    const double sh = u(t.counters.tests_of(RayKind::kShadow));
+    const double pred = predict(c, "failed_tests_worst", formulas::failed_tests_worst(n, m, l));
+    std::vector<double> row = blank;
+    row[1] = n, row[2] = m, row[3] = l, row[4] = prim;  // split: NaN
+    row[col("part")] = 1, row[col("secondary_renderer")] = renderer;
+    row[col("shadow")] = sh, row[col("pred_shadow")] = pred;
+    r.table.add(row);
+    const std::string who = renderer == 0 ? "traditional" : "stochastic";
+    r.checks.push_back({at + " " + who + ": shadow ray = corrected Second-Look sum", sh, pred, 0,
+                        Role::kSupports, "Failed tests (secondary, worst case)"});
+    r.checks.push_back({at + " " + who + ": primary ray = corrected Second-Look sum", prim, pred, 0,
+                        Role::kSupports, "Failed tests (secondary, worst case)"});
+  }
+}
+
 /// Worst-case secondary rays and deterministic opacity with m failed objects per node, on
 /// builtin:line: every object and the light lie on the default ray. Returns its findings.
 std::string secondary_and_deterministic(const Config& c, ExperimentResult& r) {
@@ -40,27 +67,7 @@ std::string secondary_and_deterministic(const Config& c, ExperimentResult& r) {
     for (int l = 1; l <= k.max_l; ++l) {
       const std::string at = "n=" + str(k.n) + " m=" + str(k.m) + " l=" + str(l);
       const std::string nm = str(k.n), mm = str(k.m);
-      // Traditional (l_max = l) and stochastic (l1 = l, one level more below): the shadow ray
-      // from the hit back to the light crosses the whole line, as the primary ray did.
-      for (int renderer = 0; renderer < 2; ++renderer) {
-        const LoadedScene sc =
-            scene("line", {{"n", nm}, {"depth", str(renderer == 0 ? l : l + 1)}, {"m", mm}});
-        const TraceOutput t = trace_centre(sc, renderer == 0 ? traditional() : at_level(l));
-        const double prim = u(t.counters.tests_of(RayKind::kPrimary));
-        const double sh = u(t.counters.tests_of(RayKind::kShadow));
-        const double pred =
-            predict(c, "failed_tests_worst", formulas::failed_tests_worst(k.n, k.m, l));
-        std::vector<double> row = blank;
-        row[1] = k.n, row[2] = k.m, row[3] = l, row[4] = prim;  // split: NaN
-        row[col("part")] = 1, row[col("secondary_renderer")] = renderer;
-        row[col("shadow")] = sh, row[col("pred_shadow")] = pred;
-        r.table.add(row);
-        const std::string who = renderer == 0 ? "traditional" : "stochastic";
-        r.checks.push_back({at + " " + who + ": shadow ray = corrected Second-Look sum", sh, pred,
-                            0, Role::kSupports, "Failed tests (secondary, worst case)"});
-        r.checks.push_back({at + " " + who + ": primary ray = corrected Second-Look sum", prim,
-                            pred, 0, Role::kSupports, "Failed tests (secondary, worst case)"});
-      }
+      worst_secondary(c, r, blank, k.n, k.m, l);
       // Deterministic opacity at level l (alpha 0.5: every amalgam of l but the last is
       // translucent and spawns a shadow ray), with and without failed objects.
       double rays[2], shadow[2];
@@ -181,40 +188,38 @@ std::string expected_with_and_without(const Config& c, ExperimentResult& r) {
          ": failed tests scale the expected cost and leave it O(log p).";
 }
 
-}  // namespace
+struct Sweep {
+  int split, max_l1;
+};
 
-ExperimentResult failed_tests(const Config& c) {
-  ExperimentResult r;
-  r.title = "\"A Second Look\": failed intersection tests";
-  r.claim =
-      "With object-grouping hierarchies the renderer tests all children of a traversed "
-      "amalgam, n that the ray meets plus m 'failed' ones; this scales the cost by about "
-      "(1 + m/n) and leaves the asymptotics O(n^{l1}) unchanged.";
-  r.prediction =
-      "`formulas::failed_tests_worst(n, m, l1)` = 1 + (1 + m/n) sum_{i=1}^{l1} n^i (the "
-      "printed summand n^{l1} + m n^{l1-1} is a typo for n^i + m n^{i-1}; "
-      "`failed_tests_worst_as_printed` shows the difference); without failed tests C_s0 (Eq. 1). "
-      "Worst-case secondary rays (builtin:line, m failed objects per node): the shadow ray "
-      "makes the same corrected sum as the primary, for the traditional (down to l_max) and "
-      "the stochastic renderer (down to l1). Deterministic opacity: as many shadow rays as "
-      "without failed tests (the amalgams of l1 on the primary ray), each entered node "
-      "costing n + m tests instead of n. Expected case (builtin:poisson, traditional, "
-      "p = n^{l_max}): `formulas::expected_tests_traditional(n, l_max, p, m)`, the cost "
-      "scaled by about (n + m)/n with the same O(log p) form.";
-  r.table.columns = {"split",
-                     "n",
-                     "m",
-                     "l1",
-                     "primary",
-                     "pred_corrected",
-                     "pred_as_printed",
-                     "line_cs0",
-                     "ratio",
-                     "one_plus_m_over_n",
-                     "growth"};
-  struct Sweep {
-    int split, max_l1;
-  };
+/// The summary rows and the panel of the prisms sweep.
+void prisms_summary(ExperimentResult& r, const std::vector<Sweep>& sweeps) {
+  r.summary_columns = r.table.columns;
+  for (std::size_t i = 0; i < r.table.rows.size(); ++i)
+    if (int(r.table.rows[i][3]) % 2 == 1 || i + 1 == r.table.rows.size() ||
+        r.table.rows[i + 1][0] != r.table.rows[i][0])
+      r.summary_rows.push_back(i);
+  Panel p{"Primary-ray tests with failed tests (builtin:prisms, front view)",
+          "l1",
+          "intersection tests, primary ray",
+          false,
+          true,
+          {}};
+  for (const Sweep& s : sweeps) {
+    const double sp = s.split;
+    p.series.push_back({"l1", "primary", "measured, split=" + str(sp), false, "split", sp});
+    p.series.push_back(
+        {"l1", "pred_corrected", "corrected sum, split=" + str(sp), true, "split", sp});
+    p.series.push_back(
+        {"l1", "line_cs0", "C_s0 (no failed tests), n=" + str(sp), true, "split", sp});
+  }
+  p.series.push_back({"l1", "pred_as_printed", "sum as printed (typo), split=2", true, "split", 2});
+  r.panels.push_back(p);
+}
+
+/// The primary ray's sum on builtin:prisms (Figure 2: n = split, m = split^3 - split), the
+/// printed sum against the corrected one and the cost against C_s0. Returns the findings' text.
+std::string prisms_sweep(const Config& c, ExperimentResult& r) {
   const std::vector<Sweep> sweeps = c.quick ? std::vector<Sweep>{{2, 6}, {3, 4}, {4, 3}}
                                             : std::vector<Sweep>{{2, 12}, {3, 7}, {4, 5}};
   for (const Sweep& s : sweeps) {
@@ -248,27 +253,7 @@ ExperimentResult failed_tests(const Config& c) {
     r.checks.push_back({"split=" + str(s.split) + " growth per level -> n (within 5%)", last[10],
                         double(n), 0.05 * n});
   }
-  r.summary_columns = r.table.columns;
-  for (std::size_t i = 0; i < r.table.rows.size(); ++i)
-    if (int(r.table.rows[i][3]) % 2 == 1 || i + 1 == r.table.rows.size() ||
-        r.table.rows[i + 1][0] != r.table.rows[i][0])
-      r.summary_rows.push_back(i);
-  Panel p{"Primary-ray tests with failed tests (builtin:prisms, front view)",
-          "l1",
-          "intersection tests, primary ray",
-          false,
-          true,
-          {}};
-  for (const Sweep& s : sweeps) {
-    const double sp = s.split;
-    p.series.push_back({"l1", "primary", "measured, split=" + str(sp), false, "split", sp});
-    p.series.push_back(
-        {"l1", "pred_corrected", "corrected sum, split=" + str(sp), true, "split", sp});
-    p.series.push_back(
-        {"l1", "line_cs0", "C_s0 (no failed tests), n=" + str(sp), true, "split", sp});
-  }
-  p.series.push_back({"l1", "pred_as_printed", "sum as printed (typo), split=2", true, "split", 2});
-  r.panels.push_back(p);
+  prisms_summary(r, sweeps);
   std::string ratios, overcount;
   for (std::size_t i = 0; i < r.table.rows.size(); ++i)
     if (i + 1 == r.table.rows.size() || r.table.rows[i + 1][0] != r.table.rows[i][0]) {
@@ -285,20 +270,56 @@ ExperimentResult failed_tests(const Config& c) {
           {"split=" + fmt(row[0]) + " printed / corrected sum -> l1 (1 - 1/n) (within 2%)",
            row[6] / row[5], limit, 0.02 * limit});
     }
+  return "The face-orthogonal centre ray tests exactly 1 + sum_{i=1}^{l1} (n^i + m n^{i-1}) "
+         "objects for every split and l1 measured: the corrected sum. The sum as printed "
+         "(summand n^{l1} + m n^{l1-1}, independent of i) overcounts by a factor that tends to "
+         "l1 (1 - 1/n) as l1 grows (" +
+         overcount +
+         ") and would be O(l1 n^{l1}); it is a typo. Measured cost relative to C_s0 (the count "
+         "without failed tests, measured on builtin:line): " +
+         ratios +
+         "the factor tends to 1 + m/n and the growth per level stays n, so the asymptotics are "
+         "unchanged, as the paper says.";
+}
+
+}  // namespace
+
+ExperimentResult failed_tests(const Config& c) {
+  ExperimentResult r;
+  r.title = "\"A Second Look\": failed intersection tests";
+  r.claim =
+      "With object-grouping hierarchies the renderer tests all children of a traversed "
+      "amalgam, n that the ray meets plus m 'failed' ones; this scales the cost by about "
+      "(1 + m/n) and leaves the asymptotics O(n^{l1}) unchanged.";
+  r.prediction =
+      "`formulas::failed_tests_worst(n, m, l1)` = 1 + (1 + m/n) sum_{i=1}^{l1} n^i (the "
+      "printed summand n^{l1} + m n^{l1-1} is a typo for n^i + m n^{i-1}; "
+      "`failed_tests_worst_as_printed` shows the difference); without failed tests C_s0 (Eq. 1). "
+      "Worst-case secondary rays (builtin:line, m failed objects per node): the shadow ray "
+      "makes the same corrected sum as the primary, for the traditional (down to l_max) and "
+      "the stochastic renderer (down to l1). Deterministic opacity: as many shadow rays as "
+      "without failed tests (the amalgams of l1 on the primary ray), each entered node "
+      "costing n + m tests instead of n. Expected case (builtin:poisson, traditional, "
+      "p = n^{l_max}): `formulas::expected_tests_traditional(n, l_max, p, m)`, the cost "
+      "scaled by about (n + m)/n with the same O(log p) form.";
+  r.table.columns = {"split",
+                     "n",
+                     "m",
+                     "l1",
+                     "primary",
+                     "pred_corrected",
+                     "pred_as_printed",
+                     "line_cs0",
+                     "ratio",
+                     "one_plus_m_over_n",
+                     "growth"};
+  const std::string prisms = prisms_sweep(c, r);
   tag(r, "Second Look sum");
   const std::string secondary = secondary_and_deterministic(c, r);
   const std::string expected = expected_with_and_without(c, r);
   r.findings =
-      "The face-orthogonal centre ray tests exactly 1 + sum_{i=1}^{l1} (n^i + m n^{i-1}) "
-      "objects for every split and l1 measured: the corrected sum. The sum as printed "
-      "(summand n^{l1} + m n^{l1-1}, independent of i) overcounts by a factor that tends to "
-      "l1 (1 - 1/n) as l1 grows (" +
-      overcount +
-      ") and would be O(l1 n^{l1}); it is a typo. Measured cost relative to C_s0 (the count "
-      "without failed tests, measured on builtin:line): " +
-      ratios +
-      "the factor tends to 1 + m/n and the growth per level stays n, so the asymptotics are "
-      "unchanged, as the paper says.\n\n"
+      prisms +
+      "\n\n"
       "Worst-case secondary rays (builtin:line with m failed objects per node, n = 2 and 3, "
       "m = 6): the shadow ray from the hit back to the light makes exactly the corrected sum, "
       "as the primary ray does, for the traditional renderer (down to l_max) and the "
