@@ -11,6 +11,8 @@
 
 namespace amalgam::experiments {
 using namespace detail;
+// Named: a unity build compiles several experiments in one translation unit.
+namespace failed_tests_parts {
 namespace {
 
 /// Adds `cols` to the table (NaN in every row so far) and returns a row of NaN of the new width.
@@ -283,8 +285,10 @@ std::string prisms_sweep(const Config& c, ExperimentResult& r) {
 }
 
 }  // namespace
+}  // namespace failed_tests_parts
 
 ExperimentResult failed_tests(const Config& c) {
+  using namespace failed_tests_parts;
   ExperimentResult r;
   r.title = "\"A Second Look\": failed intersection tests";
   r.claim =

@@ -18,6 +18,8 @@
 
 namespace amalgam::experiments {
 using namespace detail;
+// Named: a unity build compiles several experiments in one translation unit.
+namespace sorting_parts {
 namespace {
 
 struct Case {
@@ -111,8 +113,10 @@ std::string expected_case(const Config& c, ExperimentResult& r, int min_tests, i
 }
 
 }  // namespace
+}  // namespace sorting_parts
 
 ExperimentResult sorting(const Config& c) {
+  using namespace sorting_parts;
   ExperimentResult r;
   r.title = "Sorting children: its cost next to the intersection tests";
   r.claim =

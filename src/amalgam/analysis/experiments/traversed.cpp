@@ -13,6 +13,8 @@
 
 namespace amalgam::experiments {
 using namespace detail;
+// Named: a unity build compiles several experiments in one translation unit.
+namespace traversed_parts {
 namespace {
 
 struct Setup {
@@ -324,8 +326,10 @@ std::string findings(const ExperimentResult& r, int rays, const std::string& rat
 }
 
 }  // namespace
+}  // namespace traversed_parts
 
 ExperimentResult traversed(const Config& c) {
+  using namespace traversed_parts;
   ExperimentResult r;
   describe(r);
   // b = n^l1 of a few hundred amalgams, so that i ranges widely when p/b is small.
