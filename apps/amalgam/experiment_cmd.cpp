@@ -64,7 +64,9 @@ std::string gnuplot_script(const ex::ExperimentResult& r, const std::string& csv
       for (const auto& row : r.table.rows) {
         if (!s.filter.empty() && row[r.table.col(s.filter)] != s.filter_value) continue;
         if (!std::isfinite(row[xc]) || !std::isfinite(row[yc])) continue;
-        if ((p.logx && row[xc] <= 0) || (p.logy && row[yc] <= 0)) continue;
+        if ((p.x == experiments::Scale::kLog && row[xc] <= 0) ||
+            (p.y == experiments::Scale::kLog && row[yc] <= 0))
+          continue;
         std::snprintf(buf, sizeof buf, "%.10g %.10g\n", row[xc], row[yc]);
         g << buf;
       }
@@ -77,15 +79,16 @@ std::string gnuplot_script(const ex::ExperimentResult& r, const std::string& csv
   block = 0;
   for (const ex::Panel& p : r.panels) {
     g << "unset logscale\n";
-    if (p.logx) g << "set logscale x\n";
-    if (p.logy) g << "set logscale y\n";
+    if (p.x == experiments::Scale::kLog) g << "set logscale x\n";
+    if (p.y == experiments::Scale::kLog) g << "set logscale y\n";
     g << "set title " << quote(p.title) << "\nset xlabel " << quote(p.xlabel) << "\nset ylabel "
       << quote(p.ylabel) << "\n";
     g << "plot ";
     for (std::size_t i = 0; i < p.series.size(); ++i) {
       const ex::Series& s = p.series[i];
       g << (i ? ", \\\n     " : "") << "$s" << block++ << " using 1:2 with "
-        << (s.lines ? "lines lw 2" : "linespoints pt 7 ps 0.8") << " title " << quote(s.title);
+        << (s.draw == experiments::Draw::kLine ? "lines lw 2" : "linespoints pt 7 ps 0.8")
+        << " title " << quote(s.title);
     }
     g << "\n";
   }

@@ -31,19 +31,25 @@ struct Table {
   void add(std::vector<double> row) { rows.push_back(std::move(row)); }
 };
 
+/// How a curve is drawn: a line (a prediction) or points (a measurement).
+enum class Draw { kPoints, kLine };
+
+/// The scale of a plot's axis.
+enum class Scale { kLinear, kLog };
+
 /// One curve of a plot: column `y` against column `x`, optionally only the rows whose column
 /// `filter` equals `filter_value`.
 struct Series {
-  Series(std::string x_, std::string y_, std::string title_, bool lines_ = false,
+  Series(std::string x_, std::string y_, std::string title_, Draw draw_ = Draw::kPoints,
          std::string filter_ = "", double filter_value_ = 0)
       : x(std::move(x_)),
         y(std::move(y_)),
         title(std::move(title_)),
-        lines(lines_),
+        draw(draw_),
         filter(std::move(filter_)),
         filter_value(filter_value_) {}
   std::string x, y, title;
-  bool lines = false;  ///< lines (a prediction) or points (a measurement)
+  Draw draw = Draw::kPoints;
   std::string filter;
   double filter_value = 0;
 };
@@ -51,7 +57,7 @@ struct Series {
 /// One panel of a plot.
 struct Panel {
   std::string title, xlabel, ylabel;
-  bool logx = false, logy = false;
+  Scale x = Scale::kLinear, y = Scale::kLinear;
   std::vector<Series> series;
 };
 

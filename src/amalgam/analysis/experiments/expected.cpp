@@ -237,36 +237,38 @@ void add_panels(ExperimentResult& r, int depth2) {
         (row[0] == 0 && int(row[3]) % 4 == 0))
       r.summary_rows.push_back(i);
   }
-  r.panels.push_back({"Amalgams visited on level l1 (n=2)",
-                      "p (expected hits on the ray)",
-                      "mean number visited, E[i]",
-                      true,
-                      true,
-                      {{"p", "mean_i", "traditional (b = p/n), measured", false, "sweep", 0},
-                       {"p", "eq9_exact", "Eq. 9/10", true, "sweep", 0},
-                       {"p", "eq12_printed", "Eq. 12 as printed (1-e^{-n})", true, "sweep", 0},
-                       {"p", "eq12_correct", "Eq. 12 corrected 1/(1-e^{-n})", true, "sweep", 0},
-                       {"p", "mean_i", "scale-sensitive b=16, measured", false, "sweep", 1},
-                       {"p", "eq9_exact", "Eq. 9/13, b=16", true, "sweep", 1}}});
-  r.panels.push_back({"Tests per primary ray (n=2)",
-                      "p",
-                      "mean intersection tests per primary ray",
-                      true,
-                      false,
-                      {{"p", "mean_tests", "traditional, measured", false, "sweep", 0},
-                       {"p", "tests_exact", "traditional, exact expectation", true, "sweep", 0},
-                       {"p", "eq8_expected", "traditional, Eq. 8 model", true, "sweep", 0},
-                       {"p", "mean_tests", "scale-sensitive b=16, measured", false, "sweep", 1},
-                       {"p", "tests_exact", "scale-sensitive, exact expectation", true, "sweep", 1},
-                       {"p", "eq8_expected", "scale-sensitive, Eq. 8 model", true, "sweep", 1}}});
+  r.panels.push_back(
+      {"Amalgams visited on level l1 (n=2)",
+       "p (expected hits on the ray)",
+       "mean number visited, E[i]",
+       Scale::kLog,
+       Scale::kLog,
+       {{"p", "mean_i", "traditional (b = p/n), measured", Draw::kPoints, "sweep", 0},
+        {"p", "eq9_exact", "Eq. 9/10", Draw::kLine, "sweep", 0},
+        {"p", "eq12_printed", "Eq. 12 as printed (1-e^{-n})", Draw::kLine, "sweep", 0},
+        {"p", "eq12_correct", "Eq. 12 corrected 1/(1-e^{-n})", Draw::kLine, "sweep", 0},
+        {"p", "mean_i", "scale-sensitive b=16, measured", Draw::kPoints, "sweep", 1},
+        {"p", "eq9_exact", "Eq. 9/13, b=16", Draw::kLine, "sweep", 1}}});
+  r.panels.push_back(
+      {"Tests per primary ray (n=2)",
+       "p",
+       "mean intersection tests per primary ray",
+       Scale::kLog,
+       Scale::kLinear,
+       {{"p", "mean_tests", "traditional, measured", Draw::kPoints, "sweep", 0},
+        {"p", "tests_exact", "traditional, exact expectation", Draw::kLine, "sweep", 0},
+        {"p", "eq8_expected", "traditional, Eq. 8 model", Draw::kLine, "sweep", 0},
+        {"p", "mean_tests", "scale-sensitive b=16, measured", Draw::kPoints, "sweep", 1},
+        {"p", "tests_exact", "scale-sensitive, exact expectation", Draw::kLine, "sweep", 1},
+        {"p", "eq8_expected", "scale-sensitive, Eq. 8 model", Draw::kLine, "sweep", 1}}});
   r.panels.push_back({"Scale-sensitive, p = 2^{" + str(depth2) + "} fixed, b = n^{l1} varied",
                       "log_2 b = l1",
                       "mean tests per primary ray",
-                      false,
-                      false,
-                      {{"log2_b", "mean_tests", "measured", false, "sweep", 2},
-                       {"log2_b", "tests_exact", "exact expectation", true, "sweep", 2},
-                       {"log2_b", "eq8_expected", "Eq. 8 model", true, "sweep", 2}}});
+                      Scale::kLinear,
+                      Scale::kLinear,
+                      {{"log2_b", "mean_tests", "measured", Draw::kPoints, "sweep", 2},
+                       {"log2_b", "tests_exact", "exact expectation", Draw::kLine, "sweep", 2},
+                       {"log2_b", "eq8_expected", "Eq. 8 model", Draw::kLine, "sweep", 2}}});
 }
 
 /// The findings, which follow the checks (a wrong formula injected through Config::perturb

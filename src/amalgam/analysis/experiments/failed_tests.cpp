@@ -172,12 +172,12 @@ std::string expected_with_and_without(const Config& c, ExperimentResult& r) {
        "traditional, p = 2^{l_max})",
        "log2 p",
        "mean intersection tests, primary ray",
-       false,
-       false,
-       {{"log2_p", "mean_tests", "measured, m = " + str(m), false, "part", 3},
-        {"log2_p", "pred_tests", "exact expectation, m = " + str(m), true, "part", 3},
-        {"log2_p", "mean_tests_m0", "measured, m = 0", false, "part", 3},
-        {"log2_p", "pred_tests_m0", "exact expectation, m = 0", true, "part", 3}}});
+       Scale::kLinear,
+       Scale::kLinear,
+       {{"log2_p", "mean_tests", "measured, m = " + str(m), Draw::kPoints, "part", 3},
+        {"log2_p", "pred_tests", "exact expectation, m = " + str(m), Draw::kLine, "part", 3},
+        {"log2_p", "mean_tests_m0", "measured, m = 0", Draw::kPoints, "part", 3},
+        {"log2_p", "pred_tests_m0", "exact expectation, m = 0", Draw::kLine, "part", 3}}});
   return "Expected case (builtin:poisson, n = " + str(n) +
          ", traditional renderer, p = n^{l_max} " + "for l_max = 2 .. " + str(max_l) + ", " +
          str(rays) + " realisations per point): with m = " + str(m) +
@@ -204,18 +204,19 @@ void prisms_summary(ExperimentResult& r, const std::vector<Sweep>& sweeps) {
   Panel p{"Primary-ray tests with failed tests (builtin:prisms, front view)",
           "l1",
           "intersection tests, primary ray",
-          false,
-          true,
+          Scale::kLinear,
+          Scale::kLog,
           {}};
   for (const Sweep& s : sweeps) {
     const double sp = s.split;
-    p.series.push_back({"l1", "primary", "measured, split=" + str(sp), false, "split", sp});
+    p.series.push_back({"l1", "primary", "measured, split=" + str(sp), Draw::kPoints, "split", sp});
     p.series.push_back(
-        {"l1", "pred_corrected", "corrected sum, split=" + str(sp), true, "split", sp});
+        {"l1", "pred_corrected", "corrected sum, split=" + str(sp), Draw::kLine, "split", sp});
     p.series.push_back(
-        {"l1", "line_cs0", "C_s0 (no failed tests), n=" + str(sp), true, "split", sp});
+        {"l1", "line_cs0", "C_s0 (no failed tests), n=" + str(sp), Draw::kLine, "split", sp});
   }
-  p.series.push_back({"l1", "pred_as_printed", "sum as printed (typo), split=2", true, "split", 2});
+  p.series.push_back(
+      {"l1", "pred_as_printed", "sum as printed (typo), split=2", Draw::kLine, "split", 2});
   r.panels.push_back(p);
 }
 

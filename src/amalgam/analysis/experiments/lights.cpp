@@ -47,14 +47,14 @@ ExperimentResult lights(const Config& c) {
       {"Cost vs number of lights (builtin:line n=3, l_max=" + str(depth) + ", l1=" + str(l1) + ")",
        "lights",
        "tests per primary ray (all rays)",
-       false,
-       true,
-       {{"lights", "trad_total", "traditional", false},
-        {"lights", "trad_pred", "(1+L) C_t0", true},
-        {"lights", "stoch_total", "stochastic", false},
-        {"lights", "stoch_pred", "(1+L) C_s0", true},
-        {"lights", "det_total", "deterministic", false},
-        {"lights", "det_bound", "C_s0 + L C_sd1", true}}});
+       Scale::kLinear,
+       Scale::kLog,
+       {{"lights", "trad_total", "traditional", Draw::kPoints},
+        {"lights", "trad_pred", "(1+L) C_t0", Draw::kLine},
+        {"lights", "stoch_total", "stochastic", Draw::kPoints},
+        {"lights", "stoch_pred", "(1+L) C_s0", Draw::kLine},
+        {"lights", "det_total", "deterministic", Draw::kPoints},
+        {"lights", "det_bound", "C_s0 + L C_sd1", Draw::kLine}}});
   tag(r, "Lights");
   r.findings =
       "All three renderers scale exactly linearly in the number of lights L: "

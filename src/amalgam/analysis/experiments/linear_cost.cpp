@@ -181,15 +181,15 @@ ExperimentResult linear_cost(const Config& c) {
   r.panels.push_back({"Search cost on 2D hierarchies",
                       "P (objects at the bottom of the hierarchy)",
                       "nodes tested per query",
-                      true,
-                      true,
-                      {{"P", "find", "FIND (balanced tree)", false},
-                       {"P", "pt2d_tile", "PT2D, tiling (7a)", false},
-                       {"P", "pt2d_overlap", "PT2D, overlapping (7b)", false},
-                       {"P", "ray2d_tile", "RAY2D, tiling", false},
-                       {"P", "ray2d_overlap", "RAY2D, overlapping", false},
-                       {"P", "find_pred", "log2 P + 1", true},
-                       {"P", "pt2d_overlap_pred", "1 + 4(sqrt P - 1)", true}}});
+                      Scale::kLog,
+                      Scale::kLog,
+                      {{"P", "find", "FIND (balanced tree)", Draw::kPoints},
+                       {"P", "pt2d_tile", "PT2D, tiling (7a)", Draw::kPoints},
+                       {"P", "pt2d_overlap", "PT2D, overlapping (7b)", Draw::kPoints},
+                       {"P", "ray2d_tile", "RAY2D, tiling", Draw::kPoints},
+                       {"P", "ray2d_overlap", "RAY2D, overlapping", Draw::kPoints},
+                       {"P", "find_pred", "log2 P + 1", Draw::kLine},
+                       {"P", "pt2d_overlap_pred", "1 + 4(sqrt P - 1)", Draw::kLine}}});
   tag(r, "FIND / PT2D / RAY2D");
   r.findings =
       "Counts are exact node tests averaged over " + str(queries) +

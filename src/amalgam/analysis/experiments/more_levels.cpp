@@ -73,17 +73,17 @@ ExperimentResult more_levels(const Config& c) {
   r.panels.push_back({"Tests per primary ray vs added levels k (prisms corner, l1=3)",
                       "k (levels added below l1)",
                       "tests per primary ray (incl. shadow rays)",
-                      false,
-                      true,
-                      {{"k", "ss_tests_per_ray", "scale-sensitive, level 3", false},
-                       {"k", "trad_tests_per_ray", "traditional", false}}});
+                      Scale::kLinear,
+                      Scale::kLog,
+                      {{"k", "ss_tests_per_ray", "scale-sensitive, level 3", Draw::kPoints},
+                       {"k", "trad_tests_per_ray", "traditional", Draw::kPoints}}});
   r.panels.push_back({"Wall time vs k",
                       "k",
                       "render seconds (" + str(size) + "^2 px, 1 spp)",
-                      false,
-                      true,
-                      {{"k", "ss_seconds", "scale-sensitive, level 3", false},
-                       {"k", "trad_seconds", "traditional", false}}});
+                      Scale::kLinear,
+                      Scale::kLog,
+                      {{"k", "ss_seconds", "scale-sensitive, level 3", Draw::kPoints},
+                       {"k", "trad_seconds", "traditional", Draw::kPoints}}});
   tag(r, "More levels");
   // Failed tests in the expected case: every amalgam of builtin:prisms has 8 children of which
   // a ray meets a few, so the traditional renderer makes failed tests at every entered node;

@@ -121,21 +121,22 @@ ExperimentResult noise(const Config& c) {
   Panel pv{"Per-pixel variance vs samples per pixel (prisms, front, " + str(size) + "^2 px)",
            "samples per pixel",
            "mean per-pixel variance of luminance",
-           true,
-           true,
+           Scale::kLog,
+           Scale::kLog,
            {}};
   Panel pc{"Variance vs cost",
            "intersection tests per pixel",
            "mean per-pixel variance",
-           true,
-           true,
+           Scale::kLog,
+           Scale::kLog,
            {}};
   for (std::size_t ci = 0; ci < configs.size(); ++ci)
-    pv.series.push_back({"spp", "pixel_variance", configs[ci].label, false, "config", double(ci)});
+    pv.series.push_back(
+        {"spp", "pixel_variance", configs[ci].label, Draw::kPoints, "config", double(ci)});
   // tests per pixel = tests_per_sample * spp: gnuplot expression column.
   for (std::size_t ci = 0; ci < configs.size(); ++ci)
-    pc.series.push_back(
-        {"tests_per_pixel", "pixel_variance", configs[ci].label, false, "config", double(ci)});
+    pc.series.push_back({"tests_per_pixel", "pixel_variance", configs[ci].label, Draw::kPoints,
+                         "config", double(ci)});
   r.table.columns.push_back("tests_per_pixel");
   for (auto& row : r.table.rows) row.push_back(row[5] * row[2]);
   r.panels = {pv, pc};

@@ -137,18 +137,20 @@ ExperimentResult noise_baked(const Config& c) {
   Panel pv{"Per-sample variance relative to the traditional renderer",
            "level L rendered (stochastic opacity)",
            "sigma^2 (amalgams at L) / sigma^2 (traditional)",
-           false,
-           true,
+           Scale::kLinear,
+           Scale::kLog,
            {}};
   Panel pc{"Tests to reach equal noise relative to the traditional renderer",
            "level L rendered",
            "sigma^2 x tests per sample, ratio",
-           false,
-           true,
+           Scale::kLinear,
+           Scale::kLog,
            {}};
   for (std::size_t si = 0; si < specs.size(); ++si) {
-    pv.series.push_back({"level", "variance_ratio", specs[si].label, false, "scene", double(si)});
-    pc.series.push_back({"level", "cost_ratio", specs[si].label, false, "scene", double(si)});
+    pv.series.push_back(
+        {"level", "variance_ratio", specs[si].label, Draw::kPoints, "scene", double(si)});
+    pc.series.push_back(
+        {"level", "cost_ratio", specs[si].label, Draw::kPoints, "scene", double(si)});
   }
   r.panels = {pv, pc};
   r.findings =

@@ -65,12 +65,12 @@ ExperimentResult p_vs_primitives(const Config& c) {
   r.panels.push_back({"p against P, builtin:prisms (2x2x2 children, 2 primitives per leaf)",
                       "P (primitives in the scene)",
                       "p (primitives the ray examines)",
-                      true,
-                      true,
-                      {{"P", "p", "axis ray, measured", false, "ray", 0},
-                       {"P", "p", "oblique ray, measured", false, "ray", 1},
-                       {"P", "cube_root", "P^{1/3}", true, "ray", 0},
-                       {"P", "square_root", "P^{1/2} (the paper)", true, "ray", 0}}});
+                      Scale::kLog,
+                      Scale::kLog,
+                      {{"P", "p", "axis ray, measured", Draw::kPoints, "ray", 0},
+                       {"P", "p", "oblique ray, measured", Draw::kPoints, "ray", 1},
+                       {"P", "cube_root", "P^{1/3}", Draw::kLine, "ray", 0},
+                       {"P", "square_root", "P^{1/2} (the paper)", Draw::kLine, "ray", 0}}});
   const bool sqrt_holds = verdict_of(r.checks, "Fig. 2: p vs P") != Verdict::kDoesNotHold;
   r.findings =
       "The axis-parallel ray examines exactly 2^depth = 2 (P/2)^{1/3} primitives: "

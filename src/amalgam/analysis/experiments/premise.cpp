@@ -309,22 +309,24 @@ ExperimentResult premise(const Config& c) {
                        "err_kinds_pct", "tests_vs_trad", "time_vs_trad", "time_lo",
                        "time_hi"};
   for (std::size_t i = 0; i < r.table.rows.size(); ++i) r.summary_rows.push_back(i);
-  r.panels.push_back({"Render time against intersection tests",
-                      "intersection tests (all rays)",
-                      "seconds (" + str(size) + "^2 px, 1 spp, median of " + str(reps) + ")",
-                      true,
-                      true,
-                      {{"tests", "seconds", "traditional", false, "config", 0},
-                       {"tests", "seconds", "scale-sensitive, fixed level", false, "config", 1},
-                       {"tests", "seconds", "scale-sensitive, footprint 1", false, "config", 2},
-                       {"tests", "fit_tests", "fit: c x tests", false, "config", 0}}});
-  r.panels.push_back({"Scale-sensitive against traditional, same scene",
-                      "tests relative to traditional",
-                      "time relative to traditional",
-                      true,
-                      true,
-                      {{"tests_vs_trad", "time_vs_trad", "fixed level", false, "config", 1},
-                       {"tests_vs_trad", "time_vs_trad", "footprint 1", false, "config", 2}}});
+  r.panels.push_back(
+      {"Render time against intersection tests",
+       "intersection tests (all rays)",
+       "seconds (" + str(size) + "^2 px, 1 spp, median of " + str(reps) + ")",
+       Scale::kLog,
+       Scale::kLog,
+       {{"tests", "seconds", "traditional", Draw::kPoints, "config", 0},
+        {"tests", "seconds", "scale-sensitive, fixed level", Draw::kPoints, "config", 1},
+        {"tests", "seconds", "scale-sensitive, footprint 1", Draw::kPoints, "config", 2},
+        {"tests", "fit_tests", "fit: c x tests", Draw::kPoints, "config", 0}}});
+  r.panels.push_back(
+      {"Scale-sensitive against traditional, same scene",
+       "tests relative to traditional",
+       "time relative to traditional",
+       Scale::kLog,
+       Scale::kLog,
+       {{"tests_vs_trad", "time_vs_trad", "fixed level", Draw::kPoints, "config", 1},
+        {"tests_vs_trad", "time_vs_trad", "footprint 1", Draw::kPoints, "config", 2}}});
   tag(r, "Premise");
   const Verdict v_no_slower = verdict_of(r.checks, "No slower").value_or(Verdict::kNotMeasured);
   const bool tests_hold = most_tests <= 1;

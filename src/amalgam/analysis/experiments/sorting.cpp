@@ -153,17 +153,17 @@ ExperimentResult sorting(const Config& c) {
   r.panels.push_back({"Wall time per test, traditional worst case (builtin:line)",
                       "n (children a ray meets per node)",
                       "ns per intersection test (primary + shadow ray)",
-                      true,
-                      false,
-                      {{"n", "ns_per_test_sorted", "sorted order", false, "case", 0},
-                       {"n", "ns_per_test_stored", "stored order", false, "case", 0}}});
+                      Scale::kLog,
+                      Scale::kLinear,
+                      {{"n", "ns_per_test_sorted", "sorted order", Draw::kPoints, "case", 0},
+                       {"n", "ns_per_test_stored", "stored order", Draw::kPoints, "case", 0}}});
   r.panels.push_back({"Expected case (builtin:poisson, children met in reverse stored order)",
                       "n (children per node)",
                       "us per ray pair (primary + shadow ray)",
-                      true,
-                      true,
-                      {{"n", "us_sorted", "sorted order", false, "case", 1},
-                       {"n", "us_stored", "stored order", false, "case", 1}}});
+                      Scale::kLog,
+                      Scale::kLog,
+                      {{"n", "us_sorted", "sorted order", Draw::kPoints, "case", 1},
+                       {"n", "us_stored", "stored order", Draw::kPoints, "case", 1}}});
   r.findings =
       std::string(same_tests ? "Both orders make exactly the same tests here, so the time "
                                "difference is the ordering work. "

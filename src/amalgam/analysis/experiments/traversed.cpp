@@ -198,34 +198,42 @@ void add_panels(ExperimentResult& r, const std::vector<Setup>& setups) {
   Panel pe{"Expected cost vs p/b (sorted traversal, level l1 rendered)",
            "p/b (expected hits per amalgam of l1)",
            "mean per primary ray",
-           true,
-           true,
+           Scale::kLog,
+           Scale::kLog,
            {}};
   for (const Setup& s : setups) {
+    pe.series.push_back({"p_over_b", "mean_trav", "objects traversed, n=" + str(s.n), Draw::kPoints,
+                         "n", double(s.n)});
     pe.series.push_back(
-        {"p_over_b", "mean_trav", "objects traversed, n=" + str(s.n), false, "n", double(s.n)});
-    pe.series.push_back({"p_over_b", "eq8", "E[Eq. 8], n=" + str(s.n), true, "n", double(s.n)});
-    pe.series.push_back(
-        {"p_over_b", "mean_tests", "intersection tests, n=" + str(s.n), false, "n", double(s.n)});
+        {"p_over_b", "eq8", "E[Eq. 8], n=" + str(s.n), Draw::kLine, "n", double(s.n)});
+    pe.series.push_back({"p_over_b", "mean_tests", "intersection tests, n=" + str(s.n),
+                         Draw::kPoints, "n", double(s.n)});
   }
   // cb_* are NaN outside the Eqs. 5, 6 rows, i outside the Eq. 7 rows and p is NaN in both:
   // gnuplot skips non-finite points, so a filter on n alone selects the right rows per panel.
-  Panel pc{"Eqs. 5, 6: C_{l1}/b with nothing hit", "l1", "objects traversed / b", false, false, {}};
+  Panel pc{"Eqs. 5, 6: C_{l1}/b with nothing hit",
+           "l1",
+           "objects traversed / b",
+           Scale::kLinear,
+           Scale::kLinear,
+           {}};
   for (const Setup& s : setups) {
-    pc.series.push_back({"l1", "cb_measured", "measured, n=" + str(s.n), false, "n", double(s.n)});
-    pc.series.push_back({"l1", "cb_exact", "Eq. 6 exact, n=" + str(s.n), true, "n", double(s.n)});
+    pc.series.push_back(
+        {"l1", "cb_measured", "measured, n=" + str(s.n), Draw::kPoints, "n", double(s.n)});
+    pc.series.push_back(
+        {"l1", "cb_exact", "Eq. 6 exact, n=" + str(s.n), Draw::kLine, "n", double(s.n)});
   }
   Panel p7{"Eq. 7: cost of a ray stopped by the i-th amalgam, over i C_b",
            "i (amalgams of l1 reached)",
            "measured cost / (i C_b)",
-           true,
-           true,
+           Scale::kLog,
+           Scale::kLog,
            {}};
   for (const Setup& s : setups) {
-    p7.series.push_back(
-        {"i", "cost_over_eq7", "objects traversed, n=" + str(s.n), false, "n", double(s.n)});
-    p7.series.push_back(
-        {"i", "tests_over_eq7", "intersection tests, n=" + str(s.n), false, "n", double(s.n)});
+    p7.series.push_back({"i", "cost_over_eq7", "objects traversed, n=" + str(s.n), Draw::kPoints,
+                         "n", double(s.n)});
+    p7.series.push_back({"i", "tests_over_eq7", "intersection tests, n=" + str(s.n), Draw::kPoints,
+                         "n", double(s.n)});
   }
   r.panels = {pe, pc, p7};
 }

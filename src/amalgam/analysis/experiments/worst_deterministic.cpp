@@ -166,21 +166,22 @@ ExperimentResult worst_deterministic(const Config& c) {
       {"Deterministic opacity, builtin:line n=2, alpha=0.5",
        "l1 (rendered level)",
        "intersection tests per primary ray (all rays)",
-       false,
-       true,
-       {{"l1", "det_total", "measured C_s0 + shadows", false, "l_max", double(max_lmax)},
-        {"l1", "eq1_plus_eq2", "Eq. 1 + Eq. 2 (bound)", true, "l_max", double(max_lmax)},
-        {"l1", "line_exact", "exact count for this scene", true, "l_max", double(max_lmax)}}});
+       Scale::kLinear,
+       Scale::kLog,
+       {{"l1", "det_total", "measured C_s0 + shadows", Draw::kPoints, "l_max", double(max_lmax)},
+        {"l1", "eq1_plus_eq2", "Eq. 1 + Eq. 2 (bound)", Draw::kLine, "l_max", double(max_lmax)},
+        {"l1", "line_exact", "exact count for this scene", Draw::kLine, "l_max",
+         double(max_lmax)}}});
   Panel cp{"Crossover: deterministic vs traditional (n=2)",
            "l_max",
            "tests per primary ray",
-           false,
-           true,
+           Scale::kLinear,
+           Scale::kLog,
            {}};
   for (int l1 : {2, 4, max_l1 - 1})
     cp.series.push_back(
-        {"l_max", "det_total", "deterministic, l1=" + str(l1), false, "l1", double(l1)});
-  cp.series.push_back({"l_max", "trad_total", "traditional (2 C_t0)", true, "l1", 0});
+        {"l_max", "det_total", "deterministic, l1=" + str(l1), Draw::kPoints, "l1", double(l1)});
+  cp.series.push_back({"l_max", "trad_total", "traditional (2 C_t0)", Draw::kLine, "l1", 0});
   r.panels.push_back(cp);
   r.findings =
       "Primary cost is exactly C_s0 and there is exactly one shadow ray per rendered amalgam "

@@ -70,19 +70,19 @@ ExperimentResult worst_stochastic(const Config& c) {
   r.panels.push_back({"Scale-sensitive, stochastic, fixed l1 (builtin:line)",
                       "p = n^{l_max}",
                       "intersection tests per primary ray (+ shadow)",
-                      true,
-                      true,
-                      {{"p", "tests", "measured, n=2, l1=4", false, "n", 2},
-                       {"p", "eq3_2cs0", "Eq. 3, n=2", true, "n", 2},
-                       {"p", "tests", "measured, n=8, l1=2", false, "n", 8},
-                       {"p", "eq3_2cs0", "Eq. 3, n=8", true, "n", 8}}});
+                      Scale::kLog,
+                      Scale::kLog,
+                      {{"p", "tests", "measured, n=2, l1=4", Draw::kPoints, "n", 2},
+                       {"p", "eq3_2cs0", "Eq. 3, n=2", Draw::kLine, "n", 2},
+                       {"p", "tests", "measured, n=8, l1=2", Draw::kPoints, "n", 8},
+                       {"p", "eq3_2cs0", "Eq. 3, n=8", Draw::kLine, "n", 8}}});
   r.panels.push_back({"Wall time per traced ray",
                       "p = n^{l_max}",
                       "microseconds per ray (primary + shadow)",
-                      true,
-                      false,
-                      {{"p", "us_per_ray", "n=2, l1=4", false, "n", 2},
-                       {"p", "us_per_ray", "n=8, l1=2", false, "n", 8}}});
+                      Scale::kLog,
+                      Scale::kLinear,
+                      {{"p", "us_per_ray", "n=2, l1=4", Draw::kPoints, "n", 2},
+                       {"p", "us_per_ray", "n=8, l1=2", Draw::kPoints, "n", 8}}});
   tag(r, "Eq. 3");
   r.findings =
       "Measured cost equals 2 C_s0 exactly at every depth, up to p = " + fmt(pmax) +

@@ -64,15 +64,15 @@ ExperimentResult worst_traditional(const Config& c) {
   r.panels.push_back({"Traditional renderer on builtin:line",
                       "p = n^{l_max} (primitives on the ray)",
                       "intersection tests per ray",
-                      true,
-                      true,
-                      {{"p", "primary", "primary ray, n=2", false, "n", 2},
-                       {"p", "shadow", "shadow ray, n=2", false, "n", 2},
-                       {"p", "primary", "primary ray, n=3", false, "n", 3},
-                       {"p", "primary", "primary ray, n=8", false, "n", 8},
-                       {"p", "c_t0", "C_t0, n=2", true, "n", 2},
-                       {"p", "c_t0", "C_t0, n=3", true, "n", 3},
-                       {"p", "c_t0", "C_t0, n=8", true, "n", 8}}});
+                      Scale::kLog,
+                      Scale::kLog,
+                      {{"p", "primary", "primary ray, n=2", Draw::kPoints, "n", 2},
+                       {"p", "shadow", "shadow ray, n=2", Draw::kPoints, "n", 2},
+                       {"p", "primary", "primary ray, n=3", Draw::kPoints, "n", 3},
+                       {"p", "primary", "primary ray, n=8", Draw::kPoints, "n", 8},
+                       {"p", "c_t0", "C_t0, n=2", Draw::kLine, "n", 2},
+                       {"p", "c_t0", "C_t0, n=3", Draw::kLine, "n", 3},
+                       {"p", "c_t0", "C_t0, n=8", Draw::kLine, "n", 8}}});
   tag(r, "C_t0");
   r.findings =
       "Primary and shadow ray each cost exactly C_t0 for every (n, l_max) measured "
