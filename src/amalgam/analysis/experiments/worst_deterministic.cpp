@@ -10,9 +10,23 @@
 
 namespace amalgam::experiments {
 using namespace detail;
+// Named: a unity build compiles several experiments in one translation unit.
+namespace worst_deterministic_parts {
+namespace {
 
-ExperimentResult worst_deterministic(const Config& c) {
-  ExperimentResult r;
+constexpr int n = 2;
+constexpr double alpha = 0.5;  ///< the opacity of the translucent amalgams
+
+/// What the parts share: the sweep's bounds, the traditional totals (2 C_t0 by l_max) and
+/// the largest l1 at which deterministic opacity is still faster, by l_max.
+struct Sweep {
+  int max_lmax, max_l1;
+  std::vector<double> trad;
+  std::vector<int> crossover;
+};
+
+/// Title, claim, prediction and columns.
+void describe(ExperimentResult& r) {
   r.title = "Worst case, deterministic opacity (Eqs. 1, 2) and the 2 l1 = l_max crossover";
   r.claim =
       "With deterministic opacity every one of the n^{l1} translucent amalgams on level l1 "
@@ -29,11 +43,13 @@ ExperimentResult worst_deterministic(const Config& c) {
   r.table.columns = {"n",           "l1",         "l_max",        "det_primary",
                      "det_shadow",  "det_total",  "eq1_plus_eq2", "line_exact",
                      "shadow_rays", "trad_total", "det_faster",   "growth_per_level"};
-  const int n = 2;
-  const int max_lmax = c.quick ? 10 : 20;
-  const int max_l1 = c.quick ? 6 : 10;
-  const double alpha = 0.5;
-  std::vector<double> trad(max_lmax + 1, 0);
+}
+
+/// The traditional renderer's total on builtin:line for every l_max: 2 C_t0.
+void traditional_totals(const Config& c, ExperimentResult& r, Sweep& w) {
+  const int max_lmax = w.max_lmax;
+  w.trad.assign(max_lmax + 1, 0);
+  std::vector<double>& trad = w.trad;
   for (int lm = 1; lm <= max_lmax; ++lm) {
     const LoadedScene sc = scene("line", {{"n", str(n)}, {"depth", str(lm)}});
     trad[lm] = u(trace_centre(sc, traditional()).counters.total());
@@ -41,7 +57,15 @@ ExperimentResult worst_deterministic(const Config& c) {
                         2 * predict(c, "c_t0", formulas::c_t0(n, lm)), 0});
   }
   tag(r, "C_t0");
-  std::vector<int> crossover(max_lmax + 1, -1);  // largest l1 where deterministic is faster
+}
+
+/// Deterministic opacity at every (l1, l_max): its row, Eqs. 1 and 2 at l_max = l1 + 1,
+/// and the crossover with the traditional renderer.
+void deterministic_grid(const Config& c, ExperimentResult& r, Sweep& w) {
+  const int max_lmax = w.max_lmax, max_l1 = w.max_l1;
+  const std::vector<double>& trad = w.trad;
+  w.crossover.assign(max_lmax + 1, -1);  // largest l1 where deterministic is faster
+  std::vector<int>& crossover = w.crossover;
   for (int l1 = 0; l1 <= max_l1; ++l1) {
     for (int lm = l1 + 1; lm <= max_lmax; ++lm) {
       const LoadedScene sc =
@@ -69,7 +93,10 @@ ExperimentResult worst_deterministic(const Config& c) {
       }
     }
   }
-  // Growth per level of the deterministic total (first row of each l1): -> n^2.
+}
+
+/// Growth per level of the deterministic total (first row of each l1), -> n^2.
+double growth(ExperimentResult& r, int max_l1) {
   std::vector<double> first_total(max_l1 + 1, 0);
   for (auto& row : r.table.rows)
     if (row[2] == row[1] + 1) first_total[int(row[1])] = row[5];
@@ -80,13 +107,27 @@ ExperimentResult worst_deterministic(const Config& c) {
   r.checks.push_back({"growth per level of C_s0+C_sd1 at largest l1 ~ n^2 = 4",
                       first_total[max_l1] / first_total[max_l1 - 1], 4.0, 0.25});
   tag(r, "Eq. 2");
+  return first_total[max_l1] / first_total[max_l1 - 1];
+}
+
+/// The crossover, by the paper's bound and as measured, for the findings.
+struct Crossover {
+  std::string table, bound_misses, measured_misses;
+  int bound_ok = 0, bound_n = 0, measured_ok = 0, measured_n = 0;
+};
+
+Crossover crossover(ExperimentResult& r, const Sweep& w) {
+  const int max_lmax = w.max_lmax, max_l1 = w.max_l1;
+  const std::vector<int>& crossover = w.crossover;
+  Crossover x;
+  int& bound_ok = x.bound_ok;
+  int& bound_n = x.bound_n;
+  std::string& bound_misses = x.bound_misses;
   // The crossover by the paper's own bound: the largest l1 with C_s0 + C_sd1 < 2 C_t0 (worst
   // case of both renderers), from the exact sums, for n = 2, 3 and 8. For n = 2 it is
   // floor(l_max / 2): (2^{l1+1} - 1)(2^{l1} + 1) < 2 (2^{l_max+1} - 1) holds for 2 l1 <= l_max
   // and fails for 2 l1 >= l_max + 1.
   const int bound_ns[] = {2, 3, 8};
-  int bound_ok = 0, bound_n = 0;
-  std::string bound_misses;
   for (int bn : bound_ns)
     for (int lm = 2; lm <= max_lmax; ++lm, ++bound_n) {
       int cross_at = -1;
@@ -97,21 +138,12 @@ ExperimentResult worst_deterministic(const Config& c) {
       else
         bound_misses += " n=" + str(bn) + " l_max=" + str(lm) + ": " + str(cross_at) + ";";
     }
-  // The efficient fraction from measured counts: objects examined down to l1 = l_max / 2
-  // (C_s0, the primary cost at that level) over all objects (C_t0, a traditional primary ray),
-  // for even l_max, against sqrt(1/p) = n^{-l_max/2}.
-  double frac_ratio = 0;
-  int frac_lm = 0;
-  for (const auto& row : r.table.rows) {
-    const int l1 = int(row[1]), lm = int(row[2]);
-    if (2 * l1 != lm || lm < frac_lm) continue;
-    frac_lm = lm;
-    frac_ratio = (row[3] / (trad[lm] / 2)) / std::pow(n, -lm / 2.0);
-  }
   // Crossover table: l1* (largest l1 still faster) vs l_max / 2, where the grid of l1 decides
   // it (l1* below the largest l1 rendered). Checked exactly, l_max by l_max.
-  std::string cross, measured_misses;
-  int measured_ok = 0, measured_n = 0;
+  std::string& cross = x.table;
+  std::string& measured_misses = x.measured_misses;
+  int& measured_ok = x.measured_ok;
+  int& measured_n = x.measured_n;
   for (int lm = 2; lm <= max_lmax; ++lm) {
     if (crossover[lm] < 0 || crossover[lm] >= max_l1) continue;
     cross += "| " + str(lm) + " | " + fmt(lm / 2.0) + " | " + str(crossover[lm]) + " | " +
@@ -131,6 +163,28 @@ ExperimentResult worst_deterministic(const Config& c) {
        "for every l_max, n = 2, 3, 8",
        double(bound_ok), double(bound_n), 0});
   tag(r, "2 l1 < l_max");
+  return x;
+}
+
+/// The efficient fraction, measured and as the exact sums give it.
+struct Fraction {
+  int lm = 0;
+  double ratio = 0, exact = 0, other_ratio = 0, other_alpha = 0;
+};
+
+Fraction efficient_fraction(const Config& c, ExperimentResult& r, const Sweep& w) {
+  const std::vector<double>& trad = w.trad;
+  // The efficient fraction from measured counts: objects examined down to l1 = l_max / 2
+  // (C_s0, the primary cost at that level) over all objects (C_t0, a traditional primary ray),
+  // for even l_max, against sqrt(1/p) = n^{-l_max/2}.
+  double frac_ratio = 0;
+  int frac_lm = 0;
+  for (const auto& row : r.table.rows) {
+    const int l1 = int(row[1]), lm = int(row[2]);
+    if (2 * l1 != lm || lm < frac_lm) continue;
+    frac_lm = lm;
+    frac_ratio = (row[3] / (trad[lm] / 2)) / std::pow(n, -lm / 2.0);
+  }
   // The fraction's constant: the alphas cancel, the measured ratio tends to n/(n-1) / (n/(n-1))
   // = 1 (exactly (n^{L/2+1} - 1)/(n^{L+1} - 1) n^{L/2} -> 1), not to alpha.
   const double frac_exact = formulas::efficient_fraction_exact(n, frac_lm) /
@@ -158,6 +212,10 @@ ExperimentResult worst_deterministic(const Config& c) {
                           "; the measured fraction by (differs by > 10%)",
                       std::min(std::fabs(frac_ratio / other_ratio / printed_change - 1), 0.1), 0.1,
                       0, Role::kRefutesPrinted, "Efficient fraction"});
+  return {frac_lm, frac_ratio, frac_exact, other_ratio, other_alpha};
+}
+
+void add_panels(ExperimentResult& r, int max_lmax, int max_l1) {
   r.summary_columns = {"l1",           "l_max",      "det_primary", "det_shadow",      "det_total",
                        "eq1_plus_eq2", "line_exact", "shadow_rays", "growth_per_level"};
   for (std::size_t i = 0; i < r.table.rows.size(); ++i)
@@ -183,42 +241,62 @@ ExperimentResult worst_deterministic(const Config& c) {
         {"l_max", "det_total", "deterministic, l1=" + str(l1), Draw::kPoints, "l1", double(l1)});
   cp.series.push_back({"l_max", "trad_total", "traditional (2 C_t0)", Draw::kLine, "l1", 0});
   r.panels.push_back(cp);
-  r.findings =
-      "Primary cost is exactly C_s0 and there is exactly one shadow ray per rendered amalgam "
-      "(n^{l1}). The measured total equals the exact count for this scene and stays below the "
-      "bound C_s0 + C_sd1 (ratio -> 1/2: each shadow ray crosses on average half of the line, "
-      "not all of it); it grows by a factor " +
-      fmt(first_total[max_l1] / first_total[max_l1 - 1]) +
-      " per level (n^2 = 4): O(n^{2 l1}) as Eq. 2 says.\n\n"
-      "Crossover (largest l1 at which deterministic still beats the traditional renderer, "
-      "measured over the (l1, l_max) grid):\n\n"
-      "| l_max | l_max/2 | measured l1* | sqrt(1/p) | n^{l1*}/n^{l_max} |\n"
-      "|---|---|---|---|---|\n" +
-      cross + "\nMeasured on builtin:line (n = 2): l1* = ceil(l_max / 2) for " + str(measured_ok) +
-      " of " + str(measured_n) + " l_max" +
-      (measured_misses.empty() ? std::string() : " (otherwise:" + measured_misses + ")") +
-      ", one level past the paper's own bound: by Eq. 1 + Eq. 2 against 2 C_t0, with the exact "
-      "sums, the crossover is floor(l_max / 2) for " +
-      str(bound_ok) + " of " + str(bound_n) + " (n, l_max) with n = 2, 3, 8" +
-      (bound_misses.empty() ? std::string() : " (otherwise:" + bound_misses + ")") +
-      ". On this scene a shadow ray crosses on average only half of the line, so the measured "
-      "deterministic cost is about half the bound. **The paper's strict 2 l1 < l_max holds "
-      "only asymptotically**: with the exact sums the deterministic renderer still beats "
-      "2 C_t0 at 2 l1 = l_max (the bound gives floor(l_max / 2), not floor((l_max - 1) / 2)), "
-      "and on the measured scene one level further.\n\n"
-      "**The efficient fraction has no free constant.** As printed, alpha n^{l_max/2} / "
-      "(alpha n^{l_max}) = alpha n^{-l_max/2} keeps an alpha that cancels. Both counts are "
-      "the same kind of sum, (n^{k+1} - 1)/(n - 1), so the fraction is "
-      "(n^{l_max/2+1} - 1)/(n^{l_max+1} - 1) -> n^{-l_max/2} = sqrt(1/p) exactly: measured "
-      "(C_s0 at l1 = l_max/2 over C_t0, l_max = " +
-      str(frac_lm) + "), fraction / sqrt(1/p) = " + fmt(frac_ratio) + " = " + fmt(frac_exact) +
-      " by the exact sums (-> 1 as l_max grows). It depends on p alone (and on n only through the "
-      "rounding of l_max/2 when l_max is "
-      "odd: l1 = floor or ceil of l_max/2 gives sqrt(1/(n p)) or sqrt(n/p)). The printed "
-      "alpha sqrt(1/p) is refuted for every alpha other than 1: halving the scene's alpha "
-      "(" +
-      fmt(alpha) + " -> " + fmt(other_alpha) + ") leaves the measured fraction at " +
-      fmt(other_ratio) + " sqrt(1/p), where the printed form would halve it.";
+}
+
+std::string findings(double grew, const Crossover& x, const Fraction& f) {
+  return "Primary cost is exactly C_s0 and there is exactly one shadow ray per rendered amalgam "
+         "(n^{l1}). The measured total equals the exact count for this scene and stays below the "
+         "bound C_s0 + C_sd1 (ratio -> 1/2: each shadow ray crosses on average half of the line, "
+         "not all of it); it grows by a factor " +
+         fmt(grew) +
+         " per level (n^2 = 4): O(n^{2 l1}) as Eq. 2 says.\n\n"
+         "Crossover (largest l1 at which deterministic still beats the traditional renderer, "
+         "measured over the (l1, l_max) grid):\n\n"
+         "| l_max | l_max/2 | measured l1* | sqrt(1/p) | n^{l1*}/n^{l_max} |\n"
+         "|---|---|---|---|---|\n" +
+         x.table + "\nMeasured on builtin:line (n = 2): l1* = ceil(l_max / 2) for " +
+         str(x.measured_ok) + " of " + str(x.measured_n) + " l_max" +
+         (x.measured_misses.empty() ? std::string() : " (otherwise:" + x.measured_misses + ")") +
+         ", one level past the paper's own bound: by Eq. 1 + Eq. 2 against 2 C_t0, with the exact "
+         "sums, the crossover is floor(l_max / 2) for " +
+         str(x.bound_ok) + " of " + str(x.bound_n) + " (n, l_max) with n = 2, 3, 8" +
+         (x.bound_misses.empty() ? std::string() : " (otherwise:" + x.bound_misses + ")") +
+         ". On this scene a shadow ray crosses on average only half of the line, so the measured "
+         "deterministic cost is about half the bound. **The paper's strict 2 l1 < l_max holds "
+         "only asymptotically**: with the exact sums the deterministic renderer still beats "
+         "2 C_t0 at 2 l1 = l_max (the bound gives floor(l_max / 2), not floor((l_max - 1) / 2)), "
+         "and on the measured scene one level further.\n\n"
+         "**The efficient fraction has no free constant.** As printed, alpha n^{l_max/2} / "
+         "(alpha n^{l_max}) = alpha n^{-l_max/2} keeps an alpha that cancels. Both counts are "
+         "the same kind of sum, (n^{k+1} - 1)/(n - 1), so the fraction is "
+         "(n^{l_max/2+1} - 1)/(n^{l_max+1} - 1) -> n^{-l_max/2} = sqrt(1/p) exactly: measured "
+         "(C_s0 at l1 = l_max/2 over C_t0, l_max = " +
+         str(f.lm) + "), fraction / sqrt(1/p) = " + fmt(f.ratio) + " = " + fmt(f.exact) +
+         " by the exact sums (-> 1 as l_max grows). It depends on p alone (and on n only through "
+         "the "
+         "rounding of l_max/2 when l_max is "
+         "odd: l1 = floor or ceil of l_max/2 gives sqrt(1/(n p)) or sqrt(n/p)). The printed "
+         "alpha sqrt(1/p) is refuted for every alpha other than 1: halving the scene's alpha "
+         "(" +
+         fmt(alpha) + " -> " + fmt(f.other_alpha) + ") leaves the measured fraction at " +
+         fmt(f.other_ratio) + " sqrt(1/p), where the printed form would halve it.";
+}
+
+}  // namespace
+}  // namespace worst_deterministic_parts
+
+ExperimentResult worst_deterministic(const Config& c) {
+  using namespace worst_deterministic_parts;
+  ExperimentResult r;
+  describe(r);
+  Sweep w{c.quick ? 10 : 20, c.quick ? 6 : 10, {}, {}};
+  traditional_totals(c, r, w);
+  deterministic_grid(c, r, w);
+  const double grew = growth(r, w.max_l1);
+  const Crossover x = crossover(r, w);
+  const Fraction f = efficient_fraction(c, r, w);
+  add_panels(r, w.max_lmax, w.max_l1);
+  r.findings = findings(grew, x, f);
   return r;
 }
 
