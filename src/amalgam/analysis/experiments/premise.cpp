@@ -108,8 +108,27 @@ std::vector<Check> no_slower_checks(const std::string& label, double tests_ratio
            time.order > 0 ? time.lo : 1.0, 1.0, 0, Role::kSupports, "No slower"}};
 }
 
-ExperimentResult premise(const Config& c) {
-  ExperimentResult r;
+// Named: a unity build compiles several experiments in one translation unit.
+namespace premise_parts {
+namespace {
+
+/// A scene and its scale-sensitive configurations.
+struct Spec {
+  std::string label, spec;
+  bool file;
+  std::vector<int> levels;  ///< scale-sensitive levels (-1: footprint 1 pixel)
+};
+const std::vector<Spec>& specs() {
+  static const std::vector<Spec> s = {
+      {"builtin:prisms corner", "corner", false, {3, 5, -1}},
+      {"builtin:prisms front", "front", false, {2, 4, -1}},
+      {"Wuson mesh", "/usr/share/assimp/models/PLY/Wuson.ply", true, {3, 6, -1}},
+      {"the field", "scenes/field.json", true, {4, 8, -1}}};
+  return s;
+}
+
+/// Title, claim, prediction and columns.
+void describe(ExperimentResult& r) {
   r.title =
       "The premise: cost = intersection tests; \"the scale-sensitive technique is no slower\"";
   r.claim =
@@ -129,99 +148,89 @@ ExperimentResult premise(const Config& c) {
                      "err_tests_pct", "err_kinds_pct", "time_vs_trad", "tests_vs_trad",
                      "seconds_min",   "seconds_max",   "time_lo",      "time_hi",
                      "time_order"};
-  struct Spec {
-    std::string label, spec;
-    bool file;
-    std::vector<int> levels;  ///< scale-sensitive levels (-1: footprint 1 pixel)
-  };
-  const std::vector<Spec> specs = {
-      {"builtin:prisms corner", "corner", false, {3, 5, -1}},
-      {"builtin:prisms front", "front", false, {2, 4, -1}},
-      {"Wuson mesh", "/usr/share/assimp/models/PLY/Wuson.ply", true, {3, 6, -1}},
-      {"the field", "scenes/field.json", true, {4, 8, -1}}};
-  const int size = c.quick ? 24 : 256;
-  // Each render is timed `reps` times after one untimed warm-up run; the runs of a scene's
-  // renders are interleaved (forward, then backward through the configurations) so that a
-  // change of the machine's load falls on all of them alike.
-  const int reps = c.quick ? 3 : 9;
-  std::string unavailable;
-  double coverage = 0;  // of each median's interval (TimeRatio)
-  for (std::size_t si = 0; si < specs.size(); ++si) {
-    const Spec& sp = specs[si];
-    std::optional<LoadedScene> s;
-    try {
-      if (!sp.file)
-        s.emplace(scene("prisms", {{"depth", "8"}, {"view", sp.spec}}));
-      else if (c.load)
-        s.emplace(c.load(sp.spec));
-      else
-        throw std::runtime_error("no scene loader given (Config::load)");
-    } catch (const std::exception& e) {
-      unavailable += "* " + sp.label + ": not measured: " + e.what() + "\n";
-      r.not_measured.push_back(sp.label + ": " + e.what());
-      continue;
-    }
-    std::vector<int> configs = {-2};  // -2: traditional
-    for (int l : sp.levels) configs.push_back(l);
-    std::vector<RenderOptions> opts;
-    for (int cfg : configs) {
-      RenderOptions o = cfg == -2 ? traditional() : cfg == -1 ? RenderOptions{} : at_level(cfg);
-      if (cfg == -1) o.lod = ByFootprint{1.0f};
-      o.width = o.height = size;
-      o.spp = 1;
-      o.threads = c.threads;
-      opts.push_back(o);
-    }
-    std::vector<RenderOutput> out(configs.size());
-    std::vector<std::vector<double>> seconds(configs.size());
-    for (std::size_t j = 0; j < configs.size(); ++j) out[j] = render(*s, opts[j]);  // warm-up
-    for (int k = 0; k < reps; ++k)
-      for (std::size_t jj = 0; jj < configs.size(); ++jj) {
-        const std::size_t j = k % 2 ? configs.size() - 1 - jj : jj;
-        out[j] = render(*s, opts[j]);
-        seconds[j].push_back(out[j].seconds);
-      }
-    const double trad_tests = u(out[0].counters.total());
-    for (std::size_t j = 0; j < configs.size(); ++j) {
-      const int cfg = configs[j];
-      const Counters& k = out[j].counters;
-      const double nodes =
-          u(k.tests_of(ObjectKind::kBoundingVolume) + k.tests_of(ObjectKind::kAmalgam));
-      const double tests = u(k.total());
-      const TimeRatio t = time_ratio(seconds[j], seconds[0]);
-      coverage = t.coverage;
-      const auto [lo, hi] = std::minmax_element(seconds[j].begin(), seconds[j].end());
-      r.table.add({double(si),
-                   double(cfg == -2   ? 0
-                          : cfg == -1 ? 2
-                                      : 1),
-                   double(cfg),
-                   median(seconds[j]),
-                   sp.file ? nodes : 0,
-                   sp.file ? 0 : nodes,
-                   u(k.tests_of(ObjectKind::kPrimitive)),
-                   u(k.rays[0]),
-                   u(k.rays[1]),
-                   tests,
-                   0,
-                   0,
-                   0,
-                   0,
-                   t.median,
-                   tests / trad_tests,
-                   *lo,
-                   *hi,
-                   t.lo,
-                   t.hi,
-                   double(t.order)});
-      if (cfg != -2)
-        for (Check& ch :
-             no_slower_checks(sp.label + (cfg == -1 ? ", footprint 1" : ", level " + str(cfg)),
-                              tests / trad_tests, t))
-          r.checks.push_back(std::move(ch));
-    }
+}
+
+/// The renders of one scene: traditional, then each configuration of `sp`; each timed
+/// `reps` times after an untimed warm-up, the runs interleaved (forward, then backward
+/// through the configurations) so that a change of the machine's load falls on all of them
+/// alike. Adds a row and the "no slower" checks per render; returns the coverage of the
+/// time ratios' intervals.
+double measure_scene(const Config& c, ExperimentResult& r, std::size_t si, const Spec& sp,
+                     const LoadedScene& scene_, int size, int reps) {
+  double coverage = 0;
+  std::vector<int> configs = {-2};  // -2: traditional
+  for (int l : sp.levels) configs.push_back(l);
+  std::vector<RenderOptions> opts;
+  for (int cfg : configs) {
+    RenderOptions o = cfg == -2 ? traditional() : cfg == -1 ? RenderOptions{} : at_level(cfg);
+    if (cfg == -1) o.lod = ByFootprint{1.0f};
+    o.width = o.height = size;
+    o.spp = 1;
+    o.threads = c.threads;
+    opts.push_back(o);
   }
-  // Fits over all renders.
+  std::vector<RenderOutput> out(configs.size());
+  std::vector<std::vector<double>> seconds(configs.size());
+  for (std::size_t j = 0; j < configs.size(); ++j) out[j] = render(scene_, opts[j]);  // warm-up
+  for (int k = 0; k < reps; ++k)
+    for (std::size_t jj = 0; jj < configs.size(); ++jj) {
+      const std::size_t j = k % 2 ? configs.size() - 1 - jj : jj;
+      out[j] = render(scene_, opts[j]);
+      seconds[j].push_back(out[j].seconds);
+    }
+  const double trad_tests = u(out[0].counters.total());
+  for (std::size_t j = 0; j < configs.size(); ++j) {
+    const int cfg = configs[j];
+    const Counters& k = out[j].counters;
+    const double nodes =
+        u(k.tests_of(ObjectKind::kBoundingVolume) + k.tests_of(ObjectKind::kAmalgam));
+    const double tests = u(k.total());
+    const TimeRatio t = time_ratio(seconds[j], seconds[0]);
+    coverage = t.coverage;
+    const auto [lo, hi] = std::minmax_element(seconds[j].begin(), seconds[j].end());
+    r.table.add({double(si),
+                 double(cfg == -2   ? 0
+                        : cfg == -1 ? 2
+                                    : 1),
+                 double(cfg),
+                 median(seconds[j]),
+                 sp.file ? nodes : 0,
+                 sp.file ? 0 : nodes,
+                 u(k.tests_of(ObjectKind::kPrimitive)),
+                 u(k.rays[0]),
+                 u(k.rays[1]),
+                 tests,
+                 0,
+                 0,
+                 0,
+                 0,
+                 t.median,
+                 tests / trad_tests,
+                 *lo,
+                 *hi,
+                 t.lo,
+                 t.hi,
+                 double(t.order)});
+    if (cfg != -2)
+      for (Check& ch :
+           no_slower_checks(sp.label + (cfg == -1 ? ", footprint 1" : ", level " + str(cfg)),
+                            tests / trad_tests, t))
+        r.checks.push_back(std::move(ch));
+  }
+  return coverage;
+}
+
+/// The fits of time against tests, alone and by kind, for the findings.
+struct Fits {
+  std::vector<double> c1, c5;
+  std::string kinds_text, dropped_text, worst_label;
+  double r2_1 = 1, r2_5 = 1, worst1 = 0, worst5 = 0;
+};
+
+/// Time fitted against the total tests and against the tests by kind (non-negative least
+/// squares through 0); fills each row's fitted times and errors.
+Fits fit_renders(ExperimentResult& r) {
+  Fits f;
   std::vector<std::vector<double>> X1, X5;
   std::vector<double> y;
   for (const auto& row : r.table.rows) {
@@ -271,7 +280,7 @@ ExperimentResult premise(const Config& c) {
     ss5 += (row[3] - row[11]) * (row[3] - row[11]);
     if (std::fabs(row[12]) > worst1) {
       worst1 = std::fabs(row[12]);
-      worst_label = specs[std::size_t(row[0])].label + " " +
+      worst_label = specs()[std::size_t(row[0])].label + " " +
                     (row[1] == 0   ? std::string("traditional")
                      : row[1] == 2 ? std::string("footprint 1")
                                    : "level " + fmt(row[2]));
@@ -279,13 +288,31 @@ ExperimentResult premise(const Config& c) {
     worst5 = std::max(worst5, std::fabs(row[13]));
   }
   const double r2_1 = ss_tot > 0 ? 1 - ss1 / ss_tot : 1, r2_5 = ss_tot > 0 ? 1 - ss5 / ss_tot : 1;
-  // "No slower" in each currency: tests (never more than traditional) and wall time (slower
-  // only where the whole range of the time ratio lies above 1; a tie otherwise).
-  const auto label_of = [&](const std::vector<double>& row) {
-    return specs[std::size_t(row[0])].label + (row[1] == 0   ? std::string(" traditional")
+  f.c1 = c1, f.c5 = c5, f.kinds_text = kinds_text, f.dropped_text = dropped_text;
+  f.worst_label = worst_label, f.r2_1 = r2_1, f.r2_5 = r2_5, f.worst1 = worst1, f.worst5 = worst5;
+  return f;
+}
+
+/// "No slower" in each currency, for the findings.
+struct NoSlower {
+  const std::vector<double>* slowest = nullptr;
+  double most_tests = 0;
+  int n_ss = 0, n_faster = 0, n_ties = 0, n_slower = 0;
+  std::string slower_list, tie_list;
+  double slower = 0, slowest_tests = 0;
+  std::string slower_label;
+};
+
+std::string label_of(const std::vector<double>& row) {
+  return specs()[std::size_t(row[0])].label + (row[1] == 0   ? std::string(" traditional")
                                                : row[1] == 2 ? std::string(", footprint 1")
                                                              : ", level " + fmt(row[2]));
-  };
+}
+
+NoSlower no_slower(const ExperimentResult& r) {
+  NoSlower v;
+  // "No slower" in each currency: tests (never more than traditional) and wall time (slower
+  // only where the whole range of the time ratio lies above 1; a tie otherwise).
   const std::vector<double>* slowest = nullptr;
   double most_tests = 0;
   int n_ss = 0, n_faster = 0, n_ties = 0, n_slower = 0;
@@ -304,6 +331,13 @@ ExperimentResult premise(const Config& c) {
   const double slower = slowest ? (*slowest)[14] : 0.0;
   const double slowest_tests = slowest ? (*slowest)[15] : 0.0;
   const std::string slower_label = slowest ? label_of(*slowest) : std::string("none");
+  v.slowest = slowest, v.most_tests = most_tests, v.n_ss = n_ss, v.n_faster = n_faster;
+  v.n_ties = n_ties, v.n_slower = n_slower, v.slower_list = slower_list, v.tie_list = tie_list;
+  v.slower = slower, v.slowest_tests = slowest_tests, v.slower_label = slower_label;
+  return v;
+}
+
+void add_panels(ExperimentResult& r, int size, int reps) {
   r.summary_columns = {"scene",         "config",        "level",        "seconds",
                        "tests",         "fit_tests",     "fit_kinds",    "err_tests_pct",
                        "err_kinds_pct", "tests_vs_trad", "time_vs_trad", "time_lo",
@@ -327,56 +361,96 @@ ExperimentResult premise(const Config& c) {
        Scale::kLog,
        {{"tests_vs_trad", "time_vs_trad", "fixed level", Draw::kPoints, "config", 1},
         {"tests_vs_trad", "time_vs_trad", "footprint 1", Draw::kPoints, "config", 2}}});
-  tag(r, "Premise");
+}
+
+std::string findings(const Config& c, const ExperimentResult& r, int size, int reps,
+                     const std::string& unavailable, double coverage, const Fits& f,
+                     const NoSlower& v) {
   const Verdict v_no_slower = verdict_of(r.checks, "No slower").value_or(Verdict::kNotMeasured);
-  const bool tests_hold = most_tests <= 1;
-  r.findings =
-      "Renders of " + str(size) + "^2 pixels, 1 spp, " + str(c.threads) +
-      " threads (0: all cores); each render timed " + str(reps) +
-      " times after an untimed warm-up, the runs of a scene's renders interleaved; seconds: "
-      "the median (config 0 traditional, 1 fixed level, 2 footprint 1 pixel).\n\n" +
-      unavailable + "* **Tests alone**: time = " + fmt(c1[0] * 1e9) +
-      " ns x tests, R^2 = " + fmt(r2_1) + "; worst render " + fmt(worst1) + "% off (" +
-      worst_label +
-      ").\n"
-      "* **Tests by kind** (ns each, non-negative least squares): " +
-      kinds_text +
-      (dropped_text.empty() ? std::string()
-                            : "; not separable from the others on these renders (fitted "
-                              "negative, dropped): " +
-                                  dropped_text) +
-      "; R^2 = " + fmt(r2_5) + ", worst render " + fmt(worst5) + "% off.\n" +
-      "* **No slower: " + to_string(v_no_slower) +
-      "**. In test counts the scale-sensitive "
-      "renderer made at most " +
-      fmt(most_tests) + " times the traditional renderer's tests on the same scene (" +
-      (tests_hold ? std::string("never more: holds in test counts")
-                  : std::string("more somewhere: does not hold in test counts")) +
-      "). In wall time (time_vs_trad: the ratio of the medians; [time_lo, time_hi]: its "
-      "interval, from a distribution-free confidence interval of each median, the order "
-      "statistics of its runs that cover it with probability " +
-      fmt(100 * coverage) +
-      "%; slower only when the whole interval lies above 1, a tie when it holds 1) " +
-      str(n_faster) + " of the " + str(n_ss) + " scale-sensitive renders were faster, " +
-      str(n_ties) + " tied and " + str(n_slower) + " slower" +
-      (n_slower ? " (" + slower_list + ")" : std::string()) +
-      (n_ties ? "; the ties: " + tie_list : std::string()) + ": " +
-      (n_slower ? std::string("does not hold in wall time") : std::string("holds in wall time")) +
-      ". The largest ratio of medians: it took at most " + fmt(slower) + " times as long (" +
-      slower_label + ", which made " + fmt(slowest_tests) +
-      " times the traditional renderer's tests" +
-      (slower > 1 && slowest_tests < 1    ? ": slower in time although it made fewer tests"
-       : slower > 1 && slowest_tests == 1 ? ": slower in time with the same number of tests"
-                                          : "") +
-      "). Wall time is measured on this machine (" + str(int(std::thread::hardware_concurrency())) +
-      " hardware threads, not reserved for this run): the verdict in time is this machine's, "
-      "at the time of the run.\n\n"
-      "Counting tests predicts render time to the extent these R^2 say; one price per test "
-      "is off by up to " +
-      fmt(worst1) + "% for a single render (" + worst_label +
-      "): explicit node tests (SIMD, several boxes at once), builtin node tests (one box, "
-      "children computed on the fly), primitive tests and the per-ray work (camera ray, "
-      "shading, shadow-ray set-up) do not cost the same.";
+  const bool tests_hold = v.most_tests <= 1;
+  return "Renders of " + str(size) + "^2 pixels, 1 spp, " + str(c.threads) +
+         " threads (0: all cores); each render timed " + str(reps) +
+         " times after an untimed warm-up, the runs of a scene's renders interleaved; seconds: "
+         "the median (config 0 traditional, 1 fixed level, 2 footprint 1 pixel).\n\n" +
+         unavailable + "* **Tests alone**: time = " + fmt(f.c1[0] * 1e9) +
+         " ns x tests, R^2 = " + fmt(f.r2_1) + "; worst render " + fmt(f.worst1) + "% off (" +
+         f.worst_label +
+         ").\n"
+         "* **Tests by kind** (ns each, non-negative least squares): " +
+         f.kinds_text +
+         (f.dropped_text.empty() ? std::string()
+                                 : "; not separable from the others on these renders (fitted "
+                                   "negative, dropped): " +
+                                       f.dropped_text) +
+         "; R^2 = " + fmt(f.r2_5) + ", worst render " + fmt(f.worst5) + "% off.\n" +
+         "* **No slower: " + to_string(v_no_slower) +
+         "**. In test counts the scale-sensitive "
+         "renderer made at most " +
+         fmt(v.most_tests) + " times the traditional renderer's tests on the same scene (" +
+         (tests_hold ? std::string("never more: holds in test counts")
+                     : std::string("more somewhere: does not hold in test counts")) +
+         "). In wall time (time_vs_trad: the ratio of the medians; [time_lo, time_hi]: its "
+         "interval, from a distribution-free confidence interval of each median, the order "
+         "statistics of its runs that cover it with probability " +
+         fmt(100 * coverage) +
+         "%; slower only when the whole interval lies above 1, a tie when it holds 1) " +
+         str(v.n_faster) + " of the " + str(v.n_ss) + " scale-sensitive renders were faster, " +
+         str(v.n_ties) + " tied and " + str(v.n_slower) + " slower" +
+         (v.n_slower ? " (" + v.slower_list + ")" : std::string()) +
+         (v.n_ties ? "; the ties: " + v.tie_list : std::string()) + ": " +
+         (v.n_slower ? std::string("does not hold in wall time")
+                     : std::string("holds in wall time")) +
+         ". The largest ratio of medians: it took at most " + fmt(v.slower) + " times as long (" +
+         v.slower_label + ", which made " + fmt(v.slowest_tests) +
+         " times the traditional renderer's tests" +
+         (v.slower > 1 && v.slowest_tests < 1    ? ": slower in time although it made fewer tests"
+          : v.slower > 1 && v.slowest_tests == 1 ? ": slower in time with the same number of tests"
+                                                 : "") +
+         "). Wall time is measured on this machine (" +
+         str(int(std::thread::hardware_concurrency())) +
+         " hardware threads, not reserved for this run): the verdict in time is this machine's, "
+         "at the time of the run.\n\n"
+         "Counting tests predicts render time to the extent these R^2 say; one price per test "
+         "is off by up to " +
+         fmt(f.worst1) + "% for a single render (" + f.worst_label +
+         "): explicit node tests (SIMD, several boxes at once), builtin node tests (one box, "
+         "children computed on the fly), primitive tests and the per-ray work (camera ray, "
+         "shading, shadow-ray set-up) do not cost the same.";
+}
+
+}  // namespace
+}  // namespace premise_parts
+
+ExperimentResult premise(const Config& c) {
+  using namespace premise_parts;
+  ExperimentResult r;
+  describe(r);
+  const int size = c.quick ? 24 : 256;
+  const int reps = c.quick ? 3 : 9;  // timed runs per render
+  std::string unavailable;
+  double coverage = 0;  // of each median's interval (TimeRatio)
+  for (std::size_t si = 0; si < specs().size(); ++si) {
+    const Spec& sp = specs()[si];
+    std::optional<LoadedScene> s;
+    try {
+      if (!sp.file)
+        s.emplace(scene("prisms", {{"depth", "8"}, {"view", sp.spec}}));
+      else if (c.load)
+        s.emplace(c.load(sp.spec));
+      else
+        throw std::runtime_error("no scene loader given (Config::load)");
+    } catch (const std::exception& e) {
+      unavailable += "* " + sp.label + ": not measured: " + e.what() + "\n";
+      r.not_measured.push_back(sp.label + ": " + e.what());
+      continue;
+    }
+    coverage = measure_scene(c, r, si, sp, *s, size, reps);
+  }
+  const Fits f = fit_renders(r);
+  const NoSlower v = no_slower(r);
+  add_panels(r, size, reps);
+  tag(r, "Premise");
+  r.findings = findings(c, r, size, reps, unavailable, coverage, f, v);
   return r;
 }
 
