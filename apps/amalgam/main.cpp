@@ -6,6 +6,7 @@
 #include <exception>
 #include <iostream>
 #include <new>
+#include <optional>
 #include <string>
 
 #include "amalgam/analysis/experiments.h"
@@ -35,141 +36,149 @@ namespace {
   std::abort();
 }
 
-}  // namespace
+/// The subcommands, what each parsed into, and whether it was given.
+struct Commands {
+  amalgam::cli::CommonOptions render_opts, trace_opts, advise_opts;
+  amalgam::cli::RenderExtras extras;
+  CLI::Option* max_memory = nullptr;
+  std::string origin, direction;  ///< trace
+  std::string exp_name, exp_out, exp_scenes;
+  bool exp_quick = false, exp_partial = false;
+  int exp_threads = 0;
+  amalgam::cli::CompareOptions cmp;
+  amalgam::cli::AdviseOptions adv;
+  CLI::App *render = nullptr, *trace = nullptr, *experiment = nullptr, *compare = nullptr,
+           *advise = nullptr;
+};
 
-int main(int argc, char** argv) {
-  using namespace amalgam;
-  std::set_terminate(on_terminate);
-#if defined(AMALGAM_HAVE_MPI)
-  cli::mpi::Session mpi_session(&argc, &argv);  // only under mpirun (docs/mpi.md)
-#endif
-  CLI::App app{
-      "amalgam: a ray tracer with renderable bounding volumes (amalgams), after "
-      "Thompson & Fussell, 'Time Costs of Ray Tracing with Amalgams' (1991)"};
-  app.set_version_flag("--version", std::string("amalgam ") + version());
-  app.require_subcommand(1);
-
-  cli::CommonOptions render_opts;
-  cli::RenderExtras extras;
-  CLI::App* render = app.add_subcommand("render", "render an image and report exact costs");
-  render_opts.add_to(*render);
-  render->add_option("--out", extras.out, "output image (.png, .exr or .pfm)")->required();
-  render->add_option("--stats", extras.stats, "write the stats JSON to FILE, or - for stdout");
-  render->add_option("--cost-image", extras.cost_image,
-                     "write intersection tests per pixel: false colour (.png) or raw (.exr/.pfm)");
-  render->add_option("--cost-range", extras.cost_range,
-                     "MIN,MAX: the log scale of the cost PNG, in tests per primary sample "
-                     "(default: the image's own range)");
-  render->add_option("--level-image", extras.level_image,
-                     "write the rendered level per pixel: colour-coded (.png) or raw (.pfm/.exr)");
-  extras.argv.assign(argv, argv + argc);
-  render->add_option("--width", render_opts.options.width, "image width (default 512)")
+void add_render(CLI::App& app, Commands& c, int argc, char** argv) {
+  namespace cli = amalgam::cli;
+  c.render = app.add_subcommand("render", "render an image and report exact costs");
+  c.render_opts.add_to(*c.render);
+  c.render->add_option("--out", c.extras.out, "output image (.png, .exr or .pfm)")->required();
+  c.render->add_option("--stats", c.extras.stats, "write the stats JSON to FILE, or - for stdout");
+  c.render->add_option(
+      "--cost-image", c.extras.cost_image,
+      "write intersection tests per pixel: false colour (.png) or raw (.exr/.pfm)");
+  c.render->add_option("--cost-range", c.extras.cost_range,
+                       "MIN,MAX: the log scale of the cost PNG, in tests per primary sample "
+                       "(default: the image's own range)");
+  c.render->add_option(
+      "--level-image", c.extras.level_image,
+      "write the rendered level per pixel: colour-coded (.png) or raw (.pfm/.exr)");
+  c.extras.argv.assign(argv, argv + argc);
+  c.render->add_option("--width", c.render_opts.options.width, "image width (default 512)")
       ->check(cli::positive_int());
-  render->add_option("--height", render_opts.options.height, "image height (default 512)")
+  c.render->add_option("--height", c.render_opts.options.height, "image height (default 512)")
       ->check(cli::positive_int());
-  render->add_option("--spp", render_opts.options.spp, "samples per pixel (default 4)")
+  c.render->add_option("--spp", c.render_opts.options.spp, "samples per pixel (default 4)")
       ->check(cli::positive_int());
-  render
-      ->add_option("--sampler", render_opts.sampler,
+  c.render
+      ->add_option("--sampler", c.render_opts.sampler,
                    "pixel sampling: independent (default: a random point per sample) or "
                    "stratified (scrambled Sobol points per pixel: edges converge faster)")
       ->check(CLI::IsMember({"independent", "stratified"}));
-  render->add_option("--checkpoint", extras.checkpoint,
-                     "checkpoint file written when interrupted (default: OUT.ckpt)");
-  render->add_flag("--resume", extras.resume,
-                   "continue an interrupted render from its checkpoint (same options)");
-  render->add_flag("--quiet", extras.quiet, "no progress bar or summary on stderr");
-  CLI::Option* max_memory = render->add_option(
-      "--max-memory", extras.max_memory,
+  c.render->add_option("--checkpoint", c.extras.checkpoint,
+                       "checkpoint file written when interrupted (default: OUT.ckpt)");
+  c.render->add_flag("--resume", c.extras.resume,
+                     "continue an interrupted render from its checkpoint (same options)");
+  c.render->add_flag("--quiet", c.extras.quiet, "no progress bar or summary on stderr");
+  c.max_memory = c.render->add_option(
+      "--max-memory", c.extras.max_memory,
       "fail early if the render needs more bytes than this (suffixes K, M, G, T; default: "
       "physical memory)");
-  render
-      ->add_option("--checkpoint-every", extras.checkpoint_every,
+  c.render
+      ->add_option("--checkpoint-every", c.extras.checkpoint_every,
                    "seconds between checkpoints while rendering (default 60; 0: after every "
                    "pass of samples)")
       ->check(cli::seconds_in(0.0, 1e9, "[0, 1e9]"));
 
-  render
-      ->add_option("--rank-timeout", extras.rank_timeout,
+  c.render
+      ->add_option("--rank-timeout", c.extras.rank_timeout,
                    "under mpirun: seconds a rank may hold a tile without answering before it is "
                    "taken as lost and its tile rendered by the others (default 600)")
       ->check(cli::seconds_in(0.001, 1e9, "[0.001, 1e9]"));
+}
 
-  cli::CommonOptions trace_opts;
-  std::string origin, direction;
-  CLI::App* trace = app.add_subcommand(
+void add_trace(CLI::App& app, Commands& c) {
+  namespace cli = amalgam::cli;
+  c.trace = app.add_subcommand(
       "trace", "trace one primary ray (default: the scene's centre ray) and print its costs");
-  trace_opts.add_to(*trace);
-  trace->add_option("--origin", origin, "ray origin x,y,z");
-  trace->add_option("--direction", direction, "ray direction x,y,z");
+  c.trace_opts.add_to(*c.trace);
+  c.trace->add_option("--origin", c.origin, "ray origin x,y,z");
+  c.trace->add_option("--direction", c.direction, "ray direction x,y,z");
   // The ray's footprint (its cone spread) is that of a pixel of a width x height image.
-  trace
-      ->add_option("--width", trace_opts.options.width,
+  c.trace
+      ->add_option("--width", c.trace_opts.options.width,
                    "image width the ray's footprint is of (default 512)")
       ->check(cli::positive_int());
-  trace->add_option("--height", trace_opts.options.height, "image height (default 512)")
+  c.trace->add_option("--height", c.trace_opts.options.height, "image height (default 512)")
       ->check(cli::positive_int());
+}
 
-  app.add_subcommand("scenes", "list the builtin scenes and their parameters");
-
-  std::string exp_name, exp_out;
-  bool exp_quick = false;
-  int exp_threads = 0;
-  std::string exp_scenes;
-  bool exp_partial = false;
-  CLI::App* experiment = app.add_subcommand(
+void add_experiment(CLI::App& app, Commands& c) {
+  namespace cli = amalgam::cli;
+  namespace experiments = amalgam::experiments;
+  c.experiment = app.add_subcommand(
       "experiment", "reproduce the paper's analyses as measured sweeps (NAME or all)");
   std::string exp_names;
   for (const std::string& n : experiments::names())
     exp_names += (exp_names.empty() ? "" : ", ") + n;
-  experiment->add_option("name", exp_name, "experiment name, or all; one of: " + exp_names)
+  c.experiment->add_option("name", c.exp_name, "experiment name, or all; one of: " + exp_names)
       ->required();
-  experiment->add_option("--out", exp_out, "output directory")->required();
-  experiment->add_flag("--quick", exp_quick, "small sizes (as the tests use)");
-  experiment->add_option("--scenes", exp_scenes,
-                         "the bundled scene files (scenes/field.json, ...) in DIR (default: "
-                         "installed with amalgam, or the source tree it was built from)");
-  experiment->add_flag("--allow-partial", exp_partial,
-                       "exit 0 with a partial report when a part cannot be measured (a scene "
-                       "file missing); otherwise that is exit 1");
-  experiment->add_option("--threads", exp_threads, "worker threads (default: all cores)")
+  c.experiment->add_option("--out", c.exp_out, "output directory")->required();
+  c.experiment->add_flag("--quick", c.exp_quick, "small sizes (as the tests use)");
+  c.experiment->add_option("--scenes", c.exp_scenes,
+                           "the bundled scene files (scenes/field.json, ...) in DIR (default: "
+                           "installed with amalgam, or the source tree it was built from)");
+  c.experiment->add_flag("--allow-partial", c.exp_partial,
+                         "exit 0 with a partial report when a part cannot be measured (a scene "
+                         "file missing); otherwise that is exit 1");
+  c.experiment->add_option("--threads", c.exp_threads, "worker threads (default: all cores)")
       ->check(cli::non_negative_int());
+}
 
-  cli::CompareOptions cmp;
-  CLI::App* compare = app.add_subcommand(
+void add_compare(CLI::App& app, Commands& c) {
+  c.compare = app.add_subcommand(
       "compare",
       "compare two images: RMSE, PSNR, SSIM on luminance, mean and max error, relative MSE");
-  compare->add_option("a", cmp.a, "first image (.png, .pfm or .exr)")->required();
-  compare->add_option("b", cmp.b, "second image, e.g. the reference (same size)")->required();
-  compare->add_option("--error-image", cmp.error_image,
-                      "write the per-pixel RMS error in false colour (.png, .exr or .pfm)");
-  compare->add_flag("--json", cmp.json, "print the figures as JSON");
+  c.compare->add_option("a", c.cmp.a, "first image (.png, .pfm or .exr)")->required();
+  c.compare->add_option("b", c.cmp.b, "second image, e.g. the reference (same size)")->required();
+  c.compare->add_option("--error-image", c.cmp.error_image,
+                        "write the per-pixel RMS error in false colour (.png, .exr or .pfm)");
+  c.compare->add_flag("--json", c.cmp.json, "print the figures as JSON");
+}
 
-  cli::CommonOptions advise_opts;
-  cli::AdviseOptions adv;
-  CLI::App* advise = app.add_subcommand(
+void add_advise(CLI::App& app, Commands& c) {
+  namespace cli = amalgam::cli;
+  c.advise = app.add_subcommand(
       "advise",
       "should I use amalgams on this scene? renders full detail, Embree (where built) and the "
       "level-of-detail renderers for equal time, prints each one's error x time against a "
       "converged full-detail estimate, and writes a side-by-side strip");
-  advise_opts.add_scene_to(*advise);
-  advise_opts.add_view_to(*advise);
-  advise->add_option("--width", adv.width, "image width (default 320)")->check(cli::positive_int());
-  advise->add_option("--height", adv.height, "image height (default 240)")
+  c.advise_opts.add_scene_to(*c.advise);
+  c.advise_opts.add_view_to(*c.advise);
+  c.advise->add_option("--width", c.adv.width, "image width (default 320)")
       ->check(cli::positive_int());
-  advise
-      ->add_option("--time", adv.seconds,
+  c.advise->add_option("--height", c.adv.height, "image height (default 240)")
+      ->check(cli::positive_int());
+  c.advise
+      ->add_option("--time", c.adv.seconds,
                    "render seconds per renderer (default: what full detail takes for 16 spp)")
       ->check(cli::seconds_in(1e-3, 86400, "[0.001, 86400]"));
-  advise
-      ->add_option("--reference-spp", adv.reference_spp,
+  c.advise
+      ->add_option("--reference-spp", c.adv.reference_spp,
                    "samples per pixel of the converged full-detail estimate (default 256)")
       ->check(cli::positive_int());
-  advise->add_option("--out", adv.out, "the side-by-side strip (.png): images, cost, levels");
-  advise->add_option("--json", adv.json, "write the table as JSON to FILE, or - for stdout");
-  advise->add_option("--keep", adv.keep,
-                     "write every render and the reference as PFM into this directory");
+  c.advise->add_option("--out", c.adv.out, "the side-by-side strip (.png): images, cost, levels");
+  c.advise->add_option("--json", c.adv.json, "write the table as JSON to FILE, or - for stdout");
+  c.advise->add_option("--keep", c.adv.keep,
+                       "write every render and the reference as PFM into this directory");
+}
 
+/// Parses the command line; returns the exit status when it ends here (help, version, a
+/// mistake: one line naming it and the help to read, exit 2).
+std::optional<int> parse(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -185,16 +194,40 @@ int main(int argc, char** argv) {
     std::cerr << "amalgam: " << e.what() << " (see '" << help << " --help')\n";
     return 2;
   }
+  return std::nullopt;
+}
 
-  extras.max_memory_given = max_memory->count() > 0;  // an empty value is given, and refused
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace amalgam;
+  std::set_terminate(on_terminate);
+#if defined(AMALGAM_HAVE_MPI)
+  cli::mpi::Session mpi_session(&argc, &argv);  // only under mpirun (docs/mpi.md)
+#endif
+  CLI::App app{
+      "amalgam: a ray tracer with renderable bounding volumes (amalgams), after "
+      "Thompson & Fussell, 'Time Costs of Ray Tracing with Amalgams' (1991)"};
+  app.set_version_flag("--version", std::string("amalgam ") + version());
+  app.require_subcommand(1);
+  Commands c;
+  add_render(app, c, argc, argv);
+  add_trace(app, c);
+  app.add_subcommand("scenes", "list the builtin scenes and their parameters");
+  add_experiment(app, c);
+  add_compare(app, c);
+  add_advise(app, c);
+  if (const std::optional<int> status = parse(app, argc, argv)) return *status;
+
+  c.extras.max_memory_given = c.max_memory->count() > 0;  // an empty value is given, and refused
   try {
-    if (render->parsed()) return cli::run_render(render_opts, extras);
-    if (trace->parsed()) return cli::run_trace(trace_opts, origin, direction);
-    if (experiment->parsed())
-      return cli::run_experiment(exp_name, exp_out, exp_quick, exp_threads, exp_scenes,
-                                 exp_partial);
-    if (compare->parsed()) return cli::run_compare(cmp);
-    if (advise->parsed()) return cli::run_advise(advise_opts, adv);
+    if (c.render->parsed()) return cli::run_render(c.render_opts, c.extras);
+    if (c.trace->parsed()) return cli::run_trace(c.trace_opts, c.origin, c.direction);
+    if (c.experiment->parsed())
+      return cli::run_experiment(c.exp_name, c.exp_out, c.exp_quick, c.exp_threads, c.exp_scenes,
+                                 c.exp_partial);
+    if (c.compare->parsed()) return cli::run_compare(c.cmp);
+    if (c.advise->parsed()) return cli::run_advise(c.advise_opts, c.adv);
     return cli::run_scenes();
   } catch (const std::bad_alloc&) {
     std::cerr << "amalgam: out of memory while " << cli::activity() << "\n";
