@@ -44,6 +44,26 @@ std::string option_text(std::string_view flag, OptionSpelling spelling, const st
   return k + "=" + value;
 }
 
+namespace {
+
+/// Embree renders every primitive (full detail): the options that choose amalgams, blend
+/// them or order amalgam's own traversal have no meaning there. Throws InputError naming the
+/// first one given.
+void refuse_for_embree(const OptionRequest& r, const Names& name, const std::string& renderer,
+                       const std::string& opacity) {
+  auto refuse = [&](const std::string& what) {
+    throw InputError(name.with("--tracer", "embree") + " renders at full detail: " + what +
+                     " does not apply");
+  };
+  if (r.renderer && renderer != "traditional") refuse(name.with("--renderer", renderer));
+  if (r.level) refuse(name("--level"));
+  if (r.footprint) refuse(name("--footprint"));
+  if (r.opacity && opacity != "stochastic") refuse(name.with("--opacity", opacity));
+  if (r.order) refuse(name("--order") + " (Embree orders its own)");
+}
+
+}  // namespace
+
 RenderOptions resolve_options(const OptionRequest& r, OptionSpelling spelling) {
   const Names name(spelling);
   auto one_of = [&](const std::optional<std::string>& v, std::string_view flag,
@@ -84,17 +104,7 @@ RenderOptions resolve_options(const OptionRequest& r, OptionSpelling spelling) {
 
   RenderOptions o;
   if (tracer == "embree") {
-    // Embree renders every primitive (full detail): the options that choose amalgams, blend
-    // them or order amalgam's own traversal have no meaning there.
-    auto refuse = [&](const std::string& what) {
-      throw InputError(name.with("--tracer", "embree") + " renders at full detail: " + what +
-                       " does not apply");
-    };
-    if (r.renderer && renderer != "traditional") refuse(name.with("--renderer", renderer));
-    if (r.level) refuse(name("--level"));
-    if (r.footprint) refuse(name("--footprint"));
-    if (r.opacity && opacity != "stochastic") refuse(name.with("--opacity", opacity));
-    if (r.order) refuse(name("--order") + " (Embree orders its own)");
+    refuse_for_embree(r, name, renderer, opacity);
     o.tracer = TracerKind::kEmbree;
     o.lod = FullDetail{};
   } else if (renderer == "traditional") {
