@@ -18,7 +18,7 @@
 // at full detail changes on purpose.
 //
 // What is guarded: `--opacity composite --footprint 2` (the best mode of the meadow yardstick,
-// docs/yardstick-meadow.md) at 8 spp, stratified, seed 0, on this street view: every 32 x 32
+// docs/yardstick.md, "The meadow") at 8 spp, stratified, seed 0, on this street view: every 32 x 32
 // tile, and the whole frame, within 3 % of the reference. Amalgams end 39-40 % of the samples
 // of the top row of tiles (the grass 9-47 m away), 2 % of the middle row and none of the
 // bottom row, so a bias of rendered amalgams shows in the top row; the test asserts that share
