@@ -10,6 +10,33 @@
 namespace amalgam::experiments {
 using namespace detail;
 
+// Named: a unity build compiles several experiments in one translation unit.
+namespace worst_stochastic_parts {
+namespace {
+
+/// Tests per ray and wall time per ray against p, for both sweeps.
+void add_panels(ExperimentResult& r) {
+  r.panels.push_back({"Scale-sensitive, stochastic, fixed l1 (builtin:line)",
+                      "p = n^{l_max}",
+                      "intersection tests per primary ray (+ shadow)",
+                      Scale::kLog,
+                      Scale::kLog,
+                      {{"p", "tests", "measured, n=2, l1=4", Draw::kPoints, "n", 2},
+                       {"p", "eq3_2cs0", "Eq. 3, n=2", Draw::kLine, "n", 2},
+                       {"p", "tests", "measured, n=8, l1=2", Draw::kPoints, "n", 8},
+                       {"p", "eq3_2cs0", "Eq. 3, n=8", Draw::kLine, "n", 8}}});
+  r.panels.push_back({"Wall time per traced ray",
+                      "p = n^{l_max}",
+                      "microseconds per ray (primary + shadow)",
+                      Scale::kLog,
+                      Scale::kLinear,
+                      {{"p", "us_per_ray", "n=2, l1=4", Draw::kPoints, "n", 2},
+                       {"p", "us_per_ray", "n=8, l1=2", Draw::kPoints, "n", 8}}});
+}
+
+}  // namespace
+}  // namespace worst_stochastic_parts
+
 ExperimentResult worst_stochastic(const Config& c) {
   ExperimentResult r;
   r.title = "Worst case, scale-sensitive renderer with stochastic opacity (Eq. 3)";
@@ -67,22 +94,7 @@ ExperimentResult worst_stochastic(const Config& c) {
                                        *std::min_element(lx.begin(), lx.end());
   const double change = 100 * tf.b * span / tmean;
   r.summary_columns = {"n", "l1", "l_max", "p", "tests", "eq3_2cs0", "us_per_ray"};
-  r.panels.push_back({"Scale-sensitive, stochastic, fixed l1 (builtin:line)",
-                      "p = n^{l_max}",
-                      "intersection tests per primary ray (+ shadow)",
-                      Scale::kLog,
-                      Scale::kLog,
-                      {{"p", "tests", "measured, n=2, l1=4", Draw::kPoints, "n", 2},
-                       {"p", "eq3_2cs0", "Eq. 3, n=2", Draw::kLine, "n", 2},
-                       {"p", "tests", "measured, n=8, l1=2", Draw::kPoints, "n", 8},
-                       {"p", "eq3_2cs0", "Eq. 3, n=8", Draw::kLine, "n", 8}}});
-  r.panels.push_back({"Wall time per traced ray",
-                      "p = n^{l_max}",
-                      "microseconds per ray (primary + shadow)",
-                      Scale::kLog,
-                      Scale::kLinear,
-                      {{"p", "us_per_ray", "n=2, l1=4", Draw::kPoints, "n", 2},
-                       {"p", "us_per_ray", "n=8, l1=2", Draw::kPoints, "n", 8}}});
+  worst_stochastic_parts::add_panels(r);
   tag(r, "Eq. 3");
   r.findings =
       "Measured cost equals 2 C_s0 exactly at every depth, up to p = " + fmt(pmax) +
