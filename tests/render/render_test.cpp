@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "amalgam/hierarchy/flatten.h"
+#include "amalgam/hierarchy/wide.h"
 #include "amalgam/load/load_scene.h"
 
 namespace amalgam {
@@ -121,6 +122,7 @@ TEST(Render, StochasticOpacityIsUnbiased) {
     amalgam.opacity = a;
     amalgam.surface.colour = {0.9f, 0.4f, 0.1f};
     h.appearances = {root, amalgam};
+    build_wide(h);  // a traversal refuses a hierarchy without its SIMD form
     LoadedScene s{"unbiased", std::move(h), Environment{}};
     s.env.camera.position = {0, 0, 5};
     s.env.camera.look_at = {0, 0, 0};
@@ -159,7 +161,9 @@ TEST(Render, ExplicitFlattenMatchesImplicit) {
   p.set("depth", "4");
   p.set("alpha", "0.4");
   const LoadedScene implicit = load_scene("builtin:line", p);
-  LoadedScene flat{"flat", flatten(std::get<TubeHierarchy>(implicit.hierarchy), 5), implicit.env};
+  ExplicitHierarchy flat_h = flatten(std::get<TubeHierarchy>(implicit.hierarchy), 5);
+  build_wide(flat_h);
+  LoadedScene flat{"flat", std::move(flat_h), implicit.env};
   for (RendererKind r : {RendererKind::kTraditional, RendererKind::kScaleSensitive}) {
     RenderOptions o;
     o.lod =

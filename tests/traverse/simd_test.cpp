@@ -26,6 +26,7 @@
 #include "amalgam/traverse/lod.h"
 #include "amalgam/traverse/reference.h"
 #include "amalgam/traverse/traverse.h"
+#include "amalgam/util/error.h"
 #include "amalgam/util/isa.h"
 #include "avx2_kernels.h"
 
@@ -403,7 +404,13 @@ TEST(SimdTraversal, BuiltinsMatchReference) {
   // spheres/boxes as primitives and amalgams rendered on every level.
   ExplicitHierarchy flat = flatten(prisms, pc.depth + 1);
   EXPECT_EQ(flat.wide_nodes(), nullptr) << "flatten does not bake; no SoA boxes yet";
+  EXPECT_TRUE(flat.wide_stale());
+  Counters unused;
+  EXPECT_THROW((Traversal<ExplicitHierarchy, TraditionalLod, StochasticOpacity>(flat, {}, unused)),
+               InternalError)
+      << "a hierarchy without its SIMD form is refused, not walked slowly";
   build_wide(flat);
+  EXPECT_FALSE(flat.wide_stale());
   ASSERT_NE(flat.wide_nodes(), nullptr);
   compare_all(flat, random_rays(pb, 300, 4), pc.depth + 1, "prisms flattened");
 

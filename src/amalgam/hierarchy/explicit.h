@@ -92,10 +92,17 @@ class ExplicitHierarchy {
     return m.colour * (uvs.empty() ? t.mean : mean_over_triangle(t, uvs[id]));
   }
   /// The SoA child boxes when they match `nodes` and the primitives are packed (else null: the
-  /// traversal's generic path).
+  /// traversal's generic source).
   const WideNodes* wide_nodes() const {
     return !nodes.empty() && wide.headers.size() == nodes.size() && prims.packed() ? &wide
                                                                                    : nullptr;
+  }
+  /// Whether the SIMD form is missing or stale: never built, or the nodes or primitives
+  /// changed since `build_wide` (an edit unpacks the store). Not when `build_wide` left it out by
+  /// design (too many records to address). A traversal refuses such a hierarchy (traverse.h)
+  /// rather than walk it silently without its SIMD form.
+  bool wide_stale() const {
+    return !nodes.empty() && !wide_nodes() && wide.unaddressable_nodes != nodes.size();
   }
   HierarchyInfo info() const {
     return {static_cast<double>(prims.size()), static_cast<double>(nodes.size()), levels};

@@ -113,9 +113,10 @@ void build_wide(ExplicitHierarchy& h) {
       return wide_pack_ref(hd.block, hd.count);
     return kWideRefLeaf | j;
   };
-  // No records though the root is interior: more than references address (the generic walk).
+  // No records though the root is interior: more than references address (the generic source).
   if (n_records == 0 && n > 0 && !h.nodes[0].leaf) {
     w = WideNodes{};
+    w.unaddressable_nodes = n;
     return;
   }
   const auto ref = [&](std::uint32_t j) {

@@ -124,6 +124,9 @@ struct WideNodes {
   /// carry their pack, not their node; LOD policies and a hit's primitive id read it).
   std::vector<std::uint32_t> pack_node;
   WideRef root = 0;  ///< the reference of node 0
+  /// `build_wide` found more records than references address: the hierarchy has no SIMD form
+  /// by design (the traversal's generic source walks it), for `unaddressable_nodes` nodes.
+  std::size_t unaddressable_nodes = 0;
   const unsigned char* pool_bytes() const {
     return reinterpret_cast<const unsigned char*>(pool.data());
   }

@@ -1,15 +1,15 @@
 #pragma once
-/// \file The fast traversal of the two-level instanced hierarchy (sorted order): the walk of
-/// wide_walk.h over the top tree's SoA blocks (`InstancedHierarchy::top_wide`) and, inside an
+/// \file The node source (walk.h) of the two-level instanced hierarchy, sorted order: as
+/// wide_walk.h's, over the top tree's SoA blocks (`InstancedHierarchy::top_wide`) and, inside an
 /// instance, over its mesh's own `WideNodes`, shared by every instance of the mesh.
 ///
 /// The ray stays in world space. A node inside an instance has as children's boxes the world
 /// boxes of their transformed boxes (`InstancedHierarchy::world_box`), computed at each visit
 /// for the whole node at once (eight lanes in the AVX2 copy) with world_box's float operations
-/// in its order, so the boxes, entries, order and counts are the generic walk's
+/// in its order, so the boxes, entries, order and counts are the reference's
 /// (tests/traverse/simd_test.cpp compares them with the scalar reference). A leaf's triangles
 /// are tested from the mesh's packs against the ray taken into the instance's object space
-/// once per instance entered (the generic path takes it there again for every triangle), and
+/// once per instance entered (the reference takes it there again for every triangle), and
 /// the SurfaceHit of the closest hit is built once, at the end (`finish`).
 
 #include <algorithm>
@@ -22,6 +22,7 @@
 #include "amalgam/hierarchy/instanced.h"
 #include "amalgam/hierarchy/wide.h"
 #include "amalgam/traverse/state.h"
+#include "amalgam/traverse/walk.h"
 #include "amalgam/traverse/wide_walk.h"
 
 namespace amalgam {
@@ -35,20 +36,33 @@ concept InstancedWideHierarchy = requires(const H& h) {
 
 AMALGAM_ISA_BEGIN
 
+/// The node source (walk.h) of the two-level instanced hierarchy: the top tree's nodes, then,
+/// at an instance leaf, the roots of its instances, whose nodes are their mesh's.
 template <class State>
-class InstancedWalk {
+class InstancedSource {
   using IH = InstancedHierarchy;
 
  public:
-  /// Traces `s.ray` from the root (its box met at `t_root`).
-  void run(State& s, const WideNodes& top, float t_root) {
-    if (stack_.size() < 64) stack_.resize(64);
+  struct Item {
+    float t;
+    WideRef ref;         ///< in the top tree (inst 0) or in the instance's mesh (hierarchy/wide.h)
+    std::uint32_t inst;  ///< 0: the top tree; else instance index + 1 (IH::slot)
+    int level;
+  };
+  using Root = WideNodes;  ///< the top tree's SIMD form
+  static constexpr bool kBoxKernel = true;
+
+  /// The per-ray constants, as the loop's locals.
+  struct RayConstants {
+    WideRay wr;
+    const WideNodes* top;
+  };
+
+  RayConstants begin(const State& s, const WideNodes& top) {
     obj_inst_ = 0;
-    if (box_rays_simple(s.ray))  // as WideWalk::run
-      loop<BoxRays::kNonZero>(s, top, t_root);
-    else
-      loop<BoxRays::kZeroAxes>(s, top, t_root);
+    return {WideRay::of(s.ray), &top};
   }
+  static Item root_item(const WideNodes& top, float t) { return {t, top.root, 0, 0}; }
 
   /// Builds the SurfaceHit of the closest hit when it is a deferred triangle: the generic
   /// path's `InstancedHierarchy::intersect` for that triangle, bit for bit.
@@ -66,67 +80,44 @@ class InstancedWalk {
     s.pending = false;
   }
 
- private:
-  struct StackItem {
-    float t;
-    WideRef ref;         ///< in the top tree (inst 0) or in the instance's mesh (hierarchy/wide.h)
-    std::uint32_t inst;  ///< 0: the top tree; else instance index + 1 (IH::slot)
-    int level;
-  };
-
-  enum class Next { kEnter, kPop, kStop };  ///< as in WideWalk
-
-  template <BoxRays kRays>
-  void loop(State& s, const WideNodes& top, float t_root) {
-    const WideRay wr = WideRay::of(s.ray);
-    StackItem* st = stack_.data();
-    std::size_t cap = stack_.size(), sp = 0;
-    StackItem it{t_root, top.root, 0, 0};
-    for (;;) {
-      s.count_reached();
-      Next next;
-      if (s.render_if_policy([&] { return node_id(s, top, it); }, it.level, it.t))
-        next = s.done ? Next::kStop : Next::kPop;
-      else if (it.inst == 0)
-        next = top_node<kRays>(s, top, wr, it, st, cap, sp);
-      else
-        next = instance_node<kRays>(s, wr, it, st, cap, sp);
-      if (next == Next::kEnter) continue;
-      if (next == Next::kStop || !s.pop_nearer(it, st, sp)) return;
-    }
-  }
-
-  /// The hierarchy's id of the node of stack item `it`.
-  static NodeId node_id(const State& s, const WideNodes& top, const StackItem& it) {
-    if (it.inst == 0) return IH::id(0, top.record_owner(it.ref));
+  /// The hierarchy's id of the node of item `it`.
+  static NodeId node_id(const State& s, const RayConstants& rc, const Item& it) {
+    if (it.inst == 0) return IH::id(0, rc.top->record_owner(it.ref));
     return IH::id(it.inst, s.h.meshes[s.h.instances[it.inst - 1].mesh].wide.node_of(it.ref));
   }
 
+  template <BoxRays kRays>
+  [[gnu::always_inline]] Next expand(State& s, const RayConstants& rc, Item& it,
+                                     WalkStack<Item>& st) {
+    if (it.inst == 0) return top_node<kRays>(s, *rc.top, rc.wr, it, st);
+    return instance_node<kRays>(s, rc.wr, it, st);
+  }
+
+ private:
   /// A top-level node: its children are top nodes or, for a leaf, instance roots.
   template <BoxRays kRays>
-  Next top_node(State& s, const WideNodes& top, const WideRay& wr, StackItem& it, StackItem*& st,
-                std::size_t& cap, std::size_t& sp) {
+  static Next top_node(State& s, const WideNodes& top, const WideRay& wr, Item& it,
+                       WalkStack<Item>& st) {
     const WideRecord rec = top.record(it.ref);
     const int count = top.child_count(it.ref);
     const int cl = it.level + 1;
     s.count_children(cl, count);
     const bool instances = it.ref & kWideRefLeaf;
     return children(
-        it, st, cap, sp, count,
+        it, st, count,
         [&](int c0, int m, float* t) {
           return box_test_block<kRays>(nth(rec, c0).boxes(), wr, s.ray.tmin, s.ray.tmax, m, t);
         },
         [&](int c) {
           const WideRef r = nth(rec, c).child(c % kBoxLanes);
-          if (!instances) return StackItem{0, r, 0, cl};
-          return StackItem{0, s.h.meshes[s.h.instances[r].mesh].wide.root, r + 1u, cl};
+          if (!instances) return Item{0, r, 0, cl};
+          return Item{0, s.h.meshes[s.h.instances[r].mesh].wide.root, r + 1u, cl};
         });
   }
 
   /// A node inside instance `it.inst`.
   template <BoxRays kRays>
-  Next instance_node(State& s, const WideRay& wr, StackItem& it, StackItem*& st, std::size_t& cap,
-                     std::size_t& sp) {
+  Next instance_node(State& s, const WideRay& wr, Item& it, WalkStack<Item>& st) {
     const std::uint32_t inst = it.inst;
     const IH::InstanceData& in = s.h.instances[inst - 1];
     const ExplicitHierarchy& mesh = s.h.meshes[in.mesh];
@@ -153,17 +144,17 @@ class InstancedWalk {
     const WideRecord rec = w.record(it.ref);
     const int count = w.child_count(it.ref);
     s.count_children(cl, count);
-    auto child = [&](int c) { return StackItem{0, nth(rec, c).child(c % kBoxLanes), inst, cl}; };
+    auto child = [&](int c) { return Item{0, nth(rec, c).child(c % kBoxLanes), inst, cl}; };
     if (in.identity) {
       return children(
-          it, st, cap, sp, count,
+          it, st, count,
           [&](int c0, int m, float* t) {
             return box_test_block<kRays>(nth(rec, c0).boxes(), wr, s.ray.tmin, s.ray.tmax, m, t);
           },
           child);
     }
     return children(
-        it, st, cap, sp, count,
+        it, st, count,
         [&](int c0, int m, float* t) {
           return world_boxes<kRays>(in, nth(rec, c0).boxes(), wr, s.ray.tmin, s.ray.tmax, m, t);
         },
@@ -181,17 +172,17 @@ class InstancedWalk {
   /// t), pushed farthest first as WideWalk does (ties: stored order); `make(c)` is child c's
   /// stack item (its t filled in here). kEnter with `it` the nearest hit child.
   template <class Test, class Make>
-  [[gnu::always_inline]] Next children(StackItem& it, StackItem*& st, std::size_t& cap,
-                                       std::size_t& sp, int count, Test&& test, Make&& make) {
-    reserve_stack(stack_, st, cap, sp + static_cast<std::size_t>(count));
-    const std::size_t base = sp;
+  [[gnu::always_inline]] static Next children(Item& it, WalkStack<Item>& st, int count, Test&& test,
+                                              Make&& make) {
+    st.reserve(st.sp + static_cast<std::size_t>(count));
+    const std::size_t base = st.sp;
     for (int c0 = 0; c0 < count; c0 += kBoxLanes) {
       alignas(32) float t[kBoxLanes];
-      push_sorted(st, sp, base, test(c0, std::min(count - c0, kBoxLanes), t), t,
+      push_sorted(st.st, st.sp, base, test(c0, std::min(count - c0, kBoxLanes), t), t,
                   [&](int lane) { return make(c0 + lane); });
     }
-    if (sp == base) return Next::kPop;
-    it = st[--sp];
+    if (st.sp == base) return Next::kPop;
+    it = st.st[--st.sp];
     return Next::kEnter;
   }
 
@@ -280,7 +271,6 @@ class InstancedWalk {
     return obj_wr_;
   }
 
-  std::vector<StackItem> stack_;
   std::uint32_t obj_inst_ = 0;  ///< the instance (+ 1) `obj_wr_` is for; 0: none yet
   WideRay obj_wr_{};
 };

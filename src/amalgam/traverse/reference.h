@@ -1,10 +1,13 @@
 #pragma once
-/// \file The scalar reference traversal: the original recursive traversal (one child at a
-/// time, `intersect_box` and the hierarchy's full `intersect` per test, a `SurfaceHit` for
-/// every accepted primitive), with the same ray state, LOD policy and opacity model as the
-/// fast one (state.h), so the fast traversal of traverse.h can be tested against it
-/// (tests/traverse/simd_test.cpp): same hit, same counts per ray kind, object kind and level,
-/// for every policy combination. Not used for rendering.
+/// \file The scalar reference traversal, an oracle written to be obviously right rather than
+/// fast: recursion on the call stack, one child at a time through `for_each_child` and
+/// `bounds` (never the SIMD form), `intersect_box` and the hierarchy's full `intersect` per
+/// test, a `SurfaceHit` for every accepted primitive, a node's hit children gathered in a
+/// vector and ordered with `std::stable_sort`. It shares only the ray state's rules (state.h:
+/// counting, LOD decisions, opacity effects) with the walk of traverse.h (walk.h and its node
+/// sources), so that tests/traverse/simd_test.cpp compares two different programs: same hit,
+/// same counts per ray kind, object kind and level, for every policy combination. Not used for
+/// rendering.
 
 #include <algorithm>
 #include <vector>
@@ -56,6 +59,9 @@ class ReferenceTraversal {
       visit(id, level);
   }
 
+  /// Sorted: every child tested (primitives at once, in stored order), then the hit node
+  /// children entered by entry distance (ties: stored order), stopping at the first beyond the
+  /// closest hit. Stored: each child entered as soon as its test succeeds.
   void visit(NodeId node, int level) {
     const int cl = level + 1;
     struct Entry {
@@ -63,33 +69,29 @@ class ReferenceTraversal {
       NodeId id;
       Bbox b;
     };
-    Entry entries[Order::kSorted ? kMaxChildren : 1];
-    int n = 0;
+    std::vector<Entry> hit;
     s_.h.for_each_child(node, [&](Child ch) {
       if (ch.is_primitive) {
         s_.count_primitives(cl);
-        if (auto hit = s_.h.intersect(ch.id, s_.ray)) s_.on_primitive(ch.id, cl, *hit);
+        if (auto h = s_.h.intersect(ch.id, s_.ray)) s_.on_primitive(ch.id, cl, *h);
         return !s_.done;
       }
       const Bbox b = s_.h.bounds(ch.id);
       s_.count_children(cl, 1);
       const auto span = intersect_box(s_.ray, b);
       if (!span) return true;
-      if constexpr (Order::kSorted) {
-        int i = n++;  // insertion sort, stable for equal t
-        while (i > 0 && entries[i - 1].t > span->t0) entries[i] = entries[i - 1], --i;
-        entries[i] = Entry{span->t0, ch.id, b};
-        return true;
-      } else {
+      if (!Order::kSorted) {
         enter(ch.id, cl, b, span->t0);
         return !s_.done;
       }
+      hit.push_back({span->t0, ch.id, b});
+      return true;
     });
-    if constexpr (Order::kSorted) {
-      for (int i = 0; i < n && !s_.done; ++i) {
-        if (entries[i].t > s_.ray.tmax) break;  // every later entry is farther still
-        enter(entries[i].id, cl, entries[i].b, entries[i].t);
-      }
+    std::stable_sort(hit.begin(), hit.end(),
+                     [](const Entry& a, const Entry& b) { return a.t < b.t; });
+    for (const Entry& e : hit) {
+      if (s_.done || e.t > s_.ray.tmax) return;  // every later entry is farther still
+      enter(e.id, cl, e.b, e.t);
     }
   }
 

@@ -1,7 +1,7 @@
 #pragma once
 /// \file The state every traversal algorithm shares while it traces one ray, and the rules
-/// applied when a ray meets a primitive or renders an amalgam, written once for all of them
-/// (generic_walk.h, wide_walk.h, instanced_walk.h, and the scalar reference, reference.h).
+/// applied when a ray meets a primitive or renders an amalgam, written once for the walk
+/// (walk.h and its node sources) and the scalar reference (reference.h).
 ///
 /// Cost accounting follows the paper: every bounding volume, amalgam and primitive a ray is
 /// tested against counts once, on the level of the object tested (root = level 0); a node is
@@ -125,17 +125,18 @@ struct RayState {
       return lod.render(b, level, ray, t, inside);
   }
 
-  /// The fast walks' step on reaching node `id_of()` (level `level`, entered at `t`): when the
-  /// LOD policy renders it, renders it (true); else false: the walk descends. The node's id is
-  /// looked up only where the policy may render.
-  template <class IdOf>
+  /// The walk's step on reaching node `id_of()` (level `level`, entered at `t`, box
+  /// `box_of(id)`): when the LOD policy renders it, renders it (true); else false: the walk
+  /// descends. The node's id and box are looked up only where the policy may render.
+  template <class IdOf, class BoxOf>
   [[gnu::always_inline]] bool render_if_policy([[maybe_unused]] IdOf&& id_of,
+                                               [[maybe_unused]] BoxOf&& box_of,
                                                [[maybe_unused]] int level,
                                                [[maybe_unused]] float t) {
     if constexpr (kMayRender) {
       if (lod.may_render(level)) {
         const NodeId id = id_of();
-        const Bbox b = h.bounds(id);
+        const Bbox b = box_of(id);
         if (renders(id, b, level, t)) {
           render_amalgam(id, level, b, t);
           return true;
@@ -145,7 +146,7 @@ struct RayState {
     return false;
   }
 
-  /// Pops the next entry of the stack `st[0, sp)` of a fast walk into `it`, skipping those
+  /// Pops the next entry of the stack `st[0, sp)` of the walk into `it`, skipping those
   /// entered beyond the closest hit so far; false when none is left.
   template <class Item>
   [[gnu::always_inline]] bool pop_nearer(Item& it, const Item* st, std::size_t& sp) const {
@@ -224,7 +225,7 @@ struct RayState {
   }
 };
 
-/// A fast walk's stack `stack`, whose base `st` and capacity `cap` the walk keeps as locals
+/// The walk's stack `stack`, whose base `st` and capacity `cap` the walk keeps as locals
 /// (members would be reloaded after every store to the stack): grown to hold `need` items.
 template <class Item>
 [[gnu::always_inline]] inline void reserve_stack(std::vector<Item>& stack, Item*& st,
@@ -234,21 +235,29 @@ template <class Item>
   st = stack.data(), cap = stack.size();
 }
 
+/// Pushes `item` (entered at `item.t`, never NaN) onto the stack `st` above `base`,
+/// insertion-sorted farthest first (the nearest is popped first). A later child (stored order)
+/// goes below the items with equal t, so that among equals the first in stored order is popped
+/// first, as a recursion enters them (stable sort).
+template <class Item>
+[[gnu::always_inline]] inline void push_one_sorted(Item* st, std::size_t& sp, std::size_t base,
+                                                   const Item& item) {
+  std::size_t i = sp++;
+  while (i > base && st[i - 1].t <= item.t) st[i] = st[i - 1], --i;
+  st[i] = item;
+}
+
 /// Pushes the hit lanes `mask` of a node's box test (entered at `t[lane]`; `make(lane)` is the
-/// child's item, its t set here) onto the stack `st` above `base`, insertion-sorted farthest
-/// first (the nearest is popped first). A later child (stored order) goes below the hits with
-/// equal t, so that among equals the first in stored order is popped first, as the recursion
-/// enters them (stable sort). Both fast walks push this way.
+/// child's item, its t set here) with `push_one_sorted`, in lane (stored) order. Never NaN: a
+/// NaN entry fails the kernel's t0 <= t1.
 template <class Item, class Make>
 [[gnu::always_inline]] inline void push_sorted(Item* st, std::size_t& sp, std::size_t base,
                                                unsigned mask, const float* t, Make&& make) {
   for (; mask; mask &= mask - 1) {
     const int lane = std::countr_zero(mask);
-    const float te = t[lane];  // never NaN: a NaN entry fails the kernel's t0 <= t1
-    std::size_t i = sp++;
-    while (i > base && st[i - 1].t <= te) st[i] = st[i - 1], --i;
-    st[i] = make(lane);
-    st[i].t = te;
+    Item item = make(lane);
+    item.t = t[lane];
+    push_one_sorted(st, sp, base, item);
   }
 }
 

@@ -3,21 +3,24 @@
 /// opacity model (opacity.h) and the child order (order.h). Two entry points, as in pbrt's
 /// Intersect / IntersectP: `intersect` (closest hit) and `transmittance` (shadow rays).
 ///
-/// It picks one algorithm per hierarchy, all sharing one ray state and its rules (state.h):
+/// Every hierarchy is traced by the one walk loop (walk.h) with the ray state and its rules
+/// (state.h); the node source is picked per hierarchy:
 /// - a hierarchy with SoA child boxes (ExplicitHierarchy, `wide_nodes()`), sorted order:
-///   wide_walk.h, iterative, a node's children tested at once with SIMD;
+///   wide_walk.h, a node's children tested at once with SIMD;
 /// - the two-level instanced hierarchy (`top_wide_nodes()`), sorted order: instanced_walk.h,
-///   the same walk over the top tree and each instance's mesh;
-/// - otherwise (the builtin implicit scenes; stored order): generic_walk.h, recursive.
-/// The scalar reference, reference.h, gives the same hits and counts for every combination
-/// (tests/traverse/simd_test.cpp).
+///   the top tree and each instance's mesh;
+/// - otherwise (the builtin implicit scenes; stored order): generic_walk.h, one child at a time.
+/// The scalar reference, reference.h, a separate recursive program, gives the same hits and
+/// counts for every combination (tests/traverse/simd_test.cpp).
 
 #include <vector>
 
 #include "amalgam/traverse/generic_walk.h"
 #include "amalgam/traverse/instanced_walk.h"
 #include "amalgam/traverse/order.h"
+#include "amalgam/traverse/walk.h"
 #include "amalgam/traverse/wide_walk.h"
+#include "amalgam/util/check.h"
 
 namespace amalgam {
 AMALGAM_ISA_BEGIN
@@ -31,7 +34,12 @@ class Traversal {
  public:
   using State = RayState<H, Lod, Opacity, Stats>;
 
-  Traversal(const H& h, const Lod& lod, Stats& counters) : s_(h, lod, counters) {}
+  Traversal(const H& h, const Lod& lod, Stats& counters) : s_(h, lod, counters) {
+    if constexpr (requires { h.wide_stale(); })
+      AMALGAM_CHECK(!h.wide_stale(),
+                    "Traversal: the hierarchy's SIMD form is missing or stale (build_wide after "
+                    "changing its nodes or primitives)");
+  }
 
   /// Closest hit along `ray`. `key` seeds this ray's stochastic decisions. Under
   /// deterministic opacity, translucent amalgams in front of the returned hit are appended to
@@ -42,9 +50,9 @@ class Traversal {
     s_.translucent = translucent;
     run();
     if constexpr (kWide) {
-      if (s_.pending) WideWalk<State>::finish(s_);
+      if (s_.pending) ExplicitSource<State>::finish(s_);
     } else if constexpr (kInstanced) {
-      if (s_.pending) InstancedWalk<State>::finish(s_);
+      if (s_.pending) InstancedSource<State>::finish(s_);
     }
     if (translucent) {
       const float t_hit = s_.hit.t;
@@ -92,13 +100,15 @@ class Traversal {
         return;
       }
     }
-    GenericWalk<State, kSorted>::enter(s_, root, 0, b, t0);
+    generic_.run(s_, {root, b}, t0);
   }
 
   struct None {};
   State s_;
-  [[no_unique_address]] std::conditional_t<kWide, WideWalk<State>, None> wide_;
-  [[no_unique_address]] std::conditional_t<kInstanced, InstancedWalk<State>, None> instanced_;
+  [[no_unique_address]] std::conditional_t<kWide, Walk<State, ExplicitSource<State>>, None> wide_;
+  [[no_unique_address]] std::conditional_t<kInstanced, Walk<State, InstancedSource<State>>, None>
+      instanced_;
+  Walk<State, GeneratorSource<State, kSorted>> generic_;
 };
 
 AMALGAM_ISA_END

@@ -1,9 +1,8 @@
 #pragma once
-/// \file The fast traversal of an explicit hierarchy (sorted order): iterative with an
-/// explicit stack, all children of a node tested at once from their SoA boxes
-/// (hierarchy/wide.h, geometry/wide_kernels.h), and the triangles of a triangle-only leaf four
-/// at a time from SoA packs: the same hits and counts as the generic walk
-/// (tests/traverse/simd_test.cpp checks it against the scalar reference).
+/// \file The node source (walk.h) of an explicit hierarchy, sorted order: all children of a
+/// node tested at once from their SoA boxes (hierarchy/wide.h, geometry/wide_kernels.h), and
+/// the triangles of a triangle-only leaf four at a time from SoA packs, with the hits and counts
+/// of the scalar reference (tests/traverse/simd_test.cpp).
 ///
 /// Speed: per ray, the watertight triangle setup is done once and a primitive hit's SurfaceHit is
 /// built only for the final closest hit; a node's box is fetched again only when the LOD policy may
@@ -17,6 +16,7 @@
 #include "amalgam/geometry/wide_kernels.h"
 #include "amalgam/hierarchy/wide.h"
 #include "amalgam/traverse/state.h"
+#include "amalgam/traverse/walk.h"
 
 namespace amalgam {
 
@@ -91,20 +91,36 @@ struct PackLeaf {
   }
 };
 
+/// The node source of an explicit hierarchy in SIMD form (walk.h): a node's children tested
+/// at once from their SoA boxes, a triangle-only leaf's triangles from their packs.
 template <class State>
-class WideWalk {
+class ExplicitSource {
  public:
-  /// Traces `s.ray` from the root (its box met at `t_root`).
-  void run(State& s, const WideNodes& w, float t_root) {
-    if (stack_.size() < 64) stack_.resize(64);
-    stack_[0] = {t_root, w.root, 0};
-    // A ray with a zero direction component needs the box test's containment branch per
-    // axis, and one with an infinite origin or inverse direction its NaN-skipping start;
-    // all others (nearly every ray) run a loop without them.
-    if (box_rays_simple(s.ray))
-      loop<BoxRays::kNonZero>(s, w);
-    else
-      loop<BoxRays::kZeroAxes>(s, w);
+  struct Item {
+    float t;
+    WideRef ref;  ///< the node (hierarchy/wide.h)
+    int level;
+  };
+  using Root = WideNodes;
+  static constexpr bool kBoxKernel = true;
+
+  /// The per-ray constants and the node arrays' bases, as the loop's locals (read through
+  /// `WideNodes`, the bases were loaded again at every node: a store to the stack may alias
+  /// them); the leaves' headers, read only for leaves that are not one-pack leaves, through
+  /// `nodes`.
+  struct RayConstants {
+    WideRay wr;
+    const unsigned char* pool;
+    const TrianglePack4* tris;
+    const WideNodes* nodes;
+  };
+
+  RayConstants begin(const State& s, const WideNodes& w) const {
+    return {WideRay::of(s.ray), w.pool_bytes(), s.h.prims.packs().data(), &w};
+  }
+  static Item root_item(const WideNodes& w, float t) { return {t, w.root, 0}; }
+  static NodeId node_id(const State&, const RayConstants& rc, const Item& it) {
+    return rc.nodes->node_of(it.ref);
   }
 
   /// Builds the SurfaceHit of the closest hit when it is a deferred triangle.
@@ -115,65 +131,23 @@ class WideWalk {
     s.pending = false;
   }
 
- private:
-  struct StackItem {
-    float t;
-    WideRef ref;  ///< the node (hierarchy/wide.h)
-    int level;
-  };
-
   /// Pushing a node's hit children farthest-first makes the pops the same depth-first,
-  /// nearest-first order as the recursion of the generic walk; a popped entry beyond the
-  /// closest hit is skipped, as the generic walk breaks there (every later sibling is farther
-  /// still). The nearest hit child is not pushed: the walk goes on with it at once (what the
-  /// pop right after the pushes would have given: its entry is <= tmax, as the box test
-  /// checked, and nothing between its test and its entry changes tmax or `done`), so a node
-  /// with one hit child costs no stack traffic. The stack is `stack_[0, sp)`, grown before a
-  /// node's children are pushed.
-  template <BoxRays kRays>
-  void loop(State& s, const WideNodes& w) {
-    // The per-ray constants and the stack's base and capacity as locals: members would be
-    // reloaded after every store to the stack (a float store may alias them).
-    const WideRay wr = WideRay::of(s.ray);
-    const Arrays arr{w.pool_bytes(), s.h.prims.packs().data(), &w};
-    StackItem* st = stack_.data();
-    std::size_t cap = stack_.size(), sp = 0;
-    StackItem it = st[0];
-    for (;;) {
-      s.count_reached();
-      const Next next = !s.render_if_policy([&] { return w.node_of(it.ref); }, it.level, it.t)
-                            ? expand<kRays>(s, arr, wr, it, st, cap, sp)
-                        : s.done ? Next::kStop
-                                 : Next::kPop;
-      if (next == Next::kEnter) continue;
-      if (next == Next::kStop || !s.pop_nearer(it, st, sp)) return;
-    }
-  }
-
-  /// The node arrays' bases as the loop's locals (read through `WideNodes`, they were loaded
-  /// again at every node: a store to the stack may alias them); the leaves' headers, read only
-  /// for leaves that are not one-pack leaves, through `nodes`.
-  struct Arrays {
-    const unsigned char* pool;
-    const TrianglePack4* tris;
-    const WideNodes* nodes;
-  };
-
-  /// What the walk does after a node: enter `it` (the nearest hit child), pop the stack, or
-  /// stop (the ray is done: a shadow ray occluded). `done` is read only where it can have
-  /// changed (after a leaf or a rendered amalgam), not at every pop.
-  enum class Next { kEnter, kPop, kStop };
-
-  /// Always inlined into the pop loop, with the pushes straight onto the stack below: as a
-  /// call per node it would save and restore registers and set up the box kernel's per-ray
-  /// constants again for every node. kEnter: `it` is now the nearest hit child, to be entered
-  /// next (the other hit children are on the stack).
+  /// nearest-first order as the recursion of the reference (reference.h); a popped entry
+  /// beyond the closest hit is skipped, as the recursion breaks there (every later sibling is
+  /// farther still). The nearest hit child is not pushed: the walk goes on with it at once
+  /// (what the pop right after the pushes would have given: its entry is <= tmax, as the box
+  /// test checked, and nothing between its test and its entry changes tmax or `done`), so a
+  /// node with one hit child costs no stack traffic.
   ///
-  /// An interior node is read from its reference alone: the record's address and the lanes
-  /// in use come from it, the children's references from the record, beside their boxes.
+  /// Always inlined into the loop, with the pushes straight onto the stack: as a call per node
+  /// it would save and restore registers and set up the box kernel's per-ray constants again
+  /// for every node. An interior node is read from its reference alone: the record's address
+  /// and the lanes in use come from it, the children's references from the record, beside
+  /// their boxes.
   template <BoxRays kRays>
-  [[gnu::always_inline]] Next expand(State& s, const Arrays& w, const WideRay& wr, StackItem& it,
-                                     StackItem*& st, std::size_t& cap, std::size_t& sp) {
+  [[gnu::always_inline]] Next expand(State& s, const RayConstants& w, Item& it,
+                                     WalkStack<Item>& st) const {
+    const WideRay& wr = w.wr;
     const WideRef ref = it.ref;
     const int cl = it.level + 1;
     if (ref & kWideRefLeaf) {
@@ -196,7 +170,7 @@ class WideWalk {
     }
     const int count = static_cast<int>(ref & 15u);
     if (count > kBoxLanes) [[unlikely]]
-      return many<kRays>(s, w, wr, it, st, cap, sp, cl);
+      return many<kRays>(s, w, it, st, cl);
     const WideRecord rec = WideRecord::at(w.pool, ref);
     s.count_children(cl, count);
     // One kernel call for the whole node: a single hit child is entered at once, without
@@ -210,25 +184,24 @@ class WideWalk {
       it = {t[l0], rec.child(l0), cl};
       return Next::kEnter;
     }
-    reserve(st, cap, sp + kBoxLanes);
+    st.reserve(st.sp + kBoxLanes);
     if ((rest & (rest - 1)) == 0) {  // two hits: one comparison (ties: the first in order)
       const int l1 = std::countr_zero(rest);
       const bool second = t[l1] < t[l0];
       const int near = second ? l1 : l0, far = second ? l0 : l1;
-      st[sp++] = {t[far], prefetched(w, rec.child(far)), cl};
+      st.st[st.sp++] = {t[far], prefetched(w, rec.child(far)), cl};
       it = {t[near], rec.child(near), cl};
       return Next::kEnter;
     }
-    push_sorted(w, st, sp, sp, mask, t, rec, cl);
-    it = st[--sp];
+    push_sorted(w, st, st.sp, mask, t, rec, cl);
+    it = st.st[--st.sp];
     return Next::kEnter;
   }
 
+ private:
   /// Child reference `c`, its record prefetched when it is an interior node: a child pushed is
-  /// entered later, if at all (on grid_1e6, random rays went from 0.43x to 0.50x Embree's
-  /// speed with it). The nearest child, entered at once, gains nothing from it. (Prefetching a
-  /// pushed one-pack leaf's pack the same way bought nothing measurable.)
-  [[gnu::always_inline]] static WideRef prefetched(const Arrays& w, WideRef c) {
+  /// entered later, if at all. The nearest child, entered at once, gains nothing from it.
+  [[gnu::always_inline]] static WideRef prefetched(const RayConstants& w, WideRef c) {
     if (!(c & kWideRefLeaf)) {
       const unsigned char* p = WideRecord::at(w.pool, c).base;
       __builtin_prefetch(p), __builtin_prefetch(p + 64), __builtin_prefetch(p + 128),
@@ -240,37 +213,32 @@ class WideWalk {
   /// A node of more than 8 children: its consecutive records, each tested and pushed, the
   /// nearest hit child then entered.
   template <BoxRays kRays>
-  Next many(State& s, const Arrays& w, const WideRay& wr, StackItem& it, StackItem*& st,
-            std::size_t& cap, std::size_t& sp, int cl) {
+  static Next many(State& s, const RayConstants& w, Item& it, WalkStack<Item>& st, int cl) {
     const int count = w.nodes->child_count(it.ref);
     s.count_children(cl, count);
-    reserve(st, cap, sp + static_cast<std::size_t>(count));
-    const std::size_t base = sp;
+    st.reserve(st.sp + static_cast<std::size_t>(count));
+    const std::size_t base = st.sp;
     WideRecord rec = w.nodes->record(it.ref);
     for (int c0 = 0; c0 < count; c0 += kBoxLanes, rec = rec.next()) {
       alignas(32) float t[kBoxLanes];
       const int m = std::min(count - c0, kBoxLanes);
-      push_sorted(w, st, sp, base,
-                  box_test_block<kRays>(rec.boxes(), wr, s.ray.tmin, s.ray.tmax, m, t), t, rec, cl);
+      push_sorted(w, st, base,
+                  box_test_block<kRays>(rec.boxes(), w.wr, s.ray.tmin, s.ray.tmax, m, t), t, rec,
+                  cl);
     }
-    if (sp == base) return Next::kPop;
-    it = st[--sp];
+    if (st.sp == base) return Next::kPop;
+    it = st.st[--st.sp];
     return Next::kEnter;
-  }
-
-  /// Grows the stack to hold `need` items (state.h, `reserve_stack`).
-  [[gnu::always_inline]] void reserve(StackItem*& st, std::size_t& cap, std::size_t need) {
-    reserve_stack(stack_, st, cap, need);
   }
 
   /// Pushes the lanes of `mask` (children `rec.child(lane)`, entered at `t[lane]`) above
   /// `base` (state.h, `push_sorted`), each interior child's record prefetched: the one push of
   /// both a node's three or more hit children and the records of a node of more than 8.
-  [[gnu::always_inline]] static void push_sorted(const Arrays& w, StackItem* st, std::size_t& sp,
+  [[gnu::always_inline]] static void push_sorted(const RayConstants& w, WalkStack<Item>& st,
                                                  std::size_t base, unsigned mask, const float* t,
                                                  const WideRecord& rec, int level) {
-    amalgam::push_sorted(st, sp, base, mask, t, [&](int lane) {
-      return StackItem{0, prefetched(w, rec.child(lane)), level};
+    amalgam::push_sorted(st.st, st.sp, base, mask, t, [&](int lane) {
+      return Item{0, prefetched(w, rec.child(lane)), level};
     });
   }
 
@@ -285,8 +253,6 @@ class WideWalk {
     }
     if (auto hit = amalgam::intersect(p, s.ray)) s.on_primitive(id, level, *hit);
   }
-
-  std::vector<StackItem> stack_;
 };
 
 AMALGAM_ISA_END
