@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <utility>
 #include <vector>
@@ -47,37 +48,13 @@ class Integrator {
     translucent_.clear();
     const TraceHit hit =
         trav_.intersect(primary, hash_combine(key, 0), Opacity::kBlends ? &translucent_ : nullptr);
-    if constexpr (Opacity::kSaturates) return li_composite(primary, key, hit);
-    std::uint64_t shadow_stream = 1;
-    SampleResult r{{}, hit};
-    const Vec3 wo = -primary.dir;
-    float through = 1.0f;
-    if constexpr (Opacity::kBlends) {
-      sort_front_to_back();
-      for (const TranslucentHit& a : translucent_) {
-        const Appearance app = h_.appearance(a.id);
-        const float w = through * a.opacity;
-        r.colour += shade(primary, a.id, app, a.surf, key, shadow_stream) * w;
-        r.normal += amalgam_normal(app, a.surf, wo) * w;
-        r.albedo += app.surface.colour * w;
-        through *= 1.0f - a.opacity;
-      }
+    if constexpr (Opacity::kSaturates) {
+      OneMemberShadowed how{*this, primary, key};
+      return blend(primary, hit, how);
+    } else {
+      EachShadowed how{*this, primary, key};
+      return blend(primary, hit, how);
     }
-    Vec3 end = env_.seen_toward(primary.dir);
-    if (hit.kind == TraceHit::Kind::kPrimitive) {
-      const Surface surf = surface_at(h_, hit.id, hit.surf);
-      const Vec3 n = surface_normal(h_, hit.id, hit.surf, wo);
-      end = direct(primary, hit.surf, n, surf, key, shadow_stream);
-      r.normal += n * through;
-      r.albedo += surf.colour * through;
-    } else if (hit.kind == TraceHit::Kind::kAmalgam) {
-      const Appearance app = h_.appearance(hit.id);
-      end = shade(primary, hit.id, app, hit.surf, key, shadow_stream);
-      r.normal += amalgam_normal(app, hit.surf, wo) * through;
-      r.albedo += app.surface.colour * through;
-    }
-    r.colour += end * through;
-    return r;
   }
 
  private:
@@ -111,90 +88,155 @@ class Integrator {
     });
   }
 
-  /// li() under CompositeOpacity: the translucent amalgams in front of the hit blended front
-  /// to back with weights w_k = T_k a_k (the hit, or the background, gets what is left), each
-  /// shaded without shadows (U_k, no rays); then one member j, chosen with probability
-  /// p_j = w_j lum(U_j) / sum_k w_k lum(U_k), is shaded with its shadow rays (D_j) and
-  /// counts w_j D_j / p_j. Its expectation is sum_k w_k D_k, the deterministic model's image,
-  /// with one set of shadow rays per sample instead of one per member.
-  SampleResult li_composite(const Ray& primary, std::uint64_t key, const TraceHit& hit) {
-    sort_front_to_back();
-    const float t_end = hit.kind == TraceHit::Kind::kNone ? kInfinity : hit.t;
+  /// The one front-to-back blend of a primary sample: the translucent amalgams in front of
+  /// the hit (under an opacity model that blends), with weights w_k = T_k a_k, T_k =
+  /// prod_{j<k} (1 - a_j), then the hit, or the background, with what is left (T_n); the normal
+  /// and albedo outputs blended with the same weights. How each member and the end are shaded
+  /// is the opacity model's strategy `how`: EachShadowed (every member with its own shadow
+  /// rays) or OneMemberShadowed (CompositeOpacity).
+  template <class How>
+  SampleResult blend(const Ray& primary, const TraceHit& hit, How& how) {
     SampleResult r{{}, hit};
     const Vec3 wo = -primary.dir;
     float through = 1.0f;
-    std::uint64_t none = 0;  // unshadowed shading traces no ray
-    members_.clear();
-    std::size_t saturated_at = translucent_.size();  // the member whose blend saturates
-    for (std::size_t k = 0; k < translucent_.size() && translucent_[k].t < t_end; ++k) {
-      const TranslucentHit& a = translucent_[k];
-      const Appearance app = h_.appearance(a.id);
-      const float w = through * a.opacity;
-      members_.push_back(
-          {w, shade<false>(primary, a.id, app, a.surf, key, none), static_cast<int>(k)});
-      r.normal += amalgam_normal(app, a.surf, wo) * w;
-      r.albedo += app.surface.colour * w;
-      through *= 1.0f - a.opacity;
-      if (saturated_at == translucent_.size() && through < kSaturatedTransmittance)
-        saturated_at = k;
+    if constexpr (Opacity::kBlends) {
+      sort_front_to_back();
+      const float t_end = hit.kind == TraceHit::Kind::kNone ? kInfinity : hit.t;
+      for (std::size_t k = 0; k < translucent_.size() && translucent_[k].t < t_end; ++k) {
+        const TranslucentHit& a = translucent_[k];
+        const Appearance app = h_.appearance(a.id);
+        const float w = through * a.opacity;
+        how.member(r, a, app, w, k);
+        r.normal += amalgam_normal(app, a.surf, wo) * w;
+        r.albedo += app.surface.colour * w;
+        through *= 1.0f - a.opacity;
+        if constexpr (Opacity::kSaturates) how.passed(k, through);
+      }
     }
-    if (through < kSaturatedTransmittance) {
-      // The ray ended there (the traversal stopped looking beyond that depth): the depth and
-      // level outputs are those of the member that saturated the blend.
-      const TranslucentHit& e = translucent_[saturated_at];
-      r.hit = TraceHit{TraceHit::Kind::kAmalgam, e.t, e.id, e.level, e.surf};
-      // Saturated (the traversal stops there): the little left is taken to look like the
-      // blend, whose weights are scaled up to sum to 1, rather than like nothing.
-      const float scale = 1.0f / (1.0f - through);
-      for (Member& m : members_) m.w *= scale;
-      r.normal = r.normal * scale;
-      r.albedo = r.albedo * scale;
-      through = 0.0f;
+    if constexpr (Opacity::kSaturates) {
+      if (through < kSaturatedTransmittance) {
+        how.saturate(r, through);
+        through = 0.0f;
+      }
     }
-    Surface hit_surface{};
-    Vec3 hit_normal{};
-    if (through == 0.0f) {
+    if (Opacity::kSaturates && through == 0.0f) {
       // saturated: neither the hit nor the background shows
     } else if (hit.kind == TraceHit::Kind::kPrimitive) {
-      hit_surface = surface_at(h_, hit.id, hit.surf);
-      hit_normal = surface_normal(h_, hit.id, hit.surf, wo);
-      members_.push_back(
-          {through, direct<false, false>(primary, hit.surf, hit_normal, hit_surface, key, none),
-           -1});
-      r.normal += hit_normal * through;
-      r.albedo += hit_surface.colour * through;
+      const Surface surf = surface_at(h_, hit.id, hit.surf);
+      const Vec3 n = surface_normal(h_, hit.id, hit.surf, wo);
+      how.end_primitive(r, hit, surf, n, through);
+      r.normal += n * through;
+      r.albedo += surf.colour * through;
     } else if (hit.kind == TraceHit::Kind::kAmalgam) {
       const Appearance app = h_.appearance(hit.id);
-      members_.push_back({through, shade<false>(primary, hit.id, app, hit.surf, key, none), -1});
+      how.end_amalgam(r, hit, app, through);
       r.normal += amalgam_normal(app, hit.surf, wo) * through;
       r.albedo += app.surface.colour * through;
     } else {
       r.colour += env_.seen_toward(primary.dir) * through;
     }
-    auto lum = [](Vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; };
-    float total = 0.0f;
-    for (const Member& m : members_) total += m.w * lum(m.u);
-    if (!(total > 0.0f)) return r;  // nothing lit even without shadows
-    float x = to_unit_float(hash_combine(key, 0x636f6d70)) * total;  // which member
-    std::size_t j = 0;
-    while (j + 1 < members_.size() && x >= members_[j].w * lum(members_[j].u))
-      x -= members_[j].w * lum(members_[j].u), ++j;
-    const Member& m = members_[j];
-    const float p = m.w * lum(m.u) / total;
-    if (!(p > 0.0f)) return r;
-    std::uint64_t stream = 1;
-    Vec3 d;
-    if (m.k >= 0) {
-      const TranslucentHit& a = translucent_[static_cast<std::size_t>(m.k)];
-      d = shade(primary, a.id, h_.appearance(a.id), a.surf, key, stream);
-    } else if (hit.kind == TraceHit::Kind::kPrimitive) {
-      d = direct(primary, hit.surf, hit_normal, hit_surface, key, stream);
-    } else {
-      d = shade(primary, hit.id, h_.appearance(hit.id), hit.surf, key, stream);
-    }
-    r.colour += d * (m.w / p);
+    how.finish(r, hit);
     return r;
   }
+
+  /// The blend's strategy under the paper's models (and every model that does not saturate):
+  /// each member, and the end, shaded with its own shadow rays (the deterministic model's
+  /// O(n^2l1) worst case), numbered in blend order.
+  struct EachShadowed {
+    Integrator& in;
+    const Ray& primary;
+    std::uint64_t key;
+    std::uint64_t stream = 1;
+
+    void member(SampleResult& r, const TranslucentHit& a, const Appearance& app, float w,
+                std::size_t) {
+      r.colour += in.shade(primary, a.id, app, a.surf, key, stream) * w;
+    }
+    void end_primitive(SampleResult& r, const TraceHit& hit, const Surface& surf, Vec3 n,
+                       float through) {
+      r.colour += in.direct(primary, hit.surf, n, surf, key, stream) * through;
+    }
+    void end_amalgam(SampleResult& r, const TraceHit& hit, const Appearance& app, float through) {
+      r.colour += in.shade(primary, hit.id, app, hit.surf, key, stream) * through;
+    }
+    void finish(SampleResult&, const TraceHit&) {}
+  };
+
+  /// The blend's strategy under CompositeOpacity: each member (and the end) shaded without
+  /// shadows (U_k, no rays); then one of them, chosen with probability p_j = w_j lum(U_j) /
+  /// sum_k w_k lum(U_k), is shaded with its shadow rays (D_j) and counts w_j D_j / p_j. Its
+  /// expectation is sum_k w_k D_k, the deterministic model's image, with one set of shadow rays
+  /// per sample instead of one per member. A blend that saturates (the traversal stopped
+  /// looking beyond that depth) ends at the member that saturated it.
+  struct OneMemberShadowed {
+    Integrator& in;
+    const Ray& primary;
+    std::uint64_t key;
+    std::uint64_t none = 0;  ///< unshadowed shading traces no ray
+    std::size_t saturated_at = std::numeric_limits<std::size_t>::max();
+    Surface hit_surface{};
+    Vec3 hit_normal{};
+
+    OneMemberShadowed(Integrator& i, const Ray& p, std::uint64_t k) : in(i), primary(p), key(k) {
+      in.members_.clear();
+    }
+    void member(SampleResult&, const TranslucentHit& a, const Appearance& app, float w,
+                std::size_t k) {
+      in.members_.push_back({w, in.template shade<false>(primary, a.id, app, a.surf, key, none),
+                             static_cast<int>(k)});
+    }
+    void passed(std::size_t k, float through) {
+      if (saturated_at == std::numeric_limits<std::size_t>::max() &&
+          through < kSaturatedTransmittance)
+        saturated_at = k;
+    }
+    /// The depth and level outputs become those of the member that saturated the blend; the
+    /// little light left is taken to look like the blend, whose weights are scaled up to sum
+    /// to 1, rather than like nothing.
+    void saturate(SampleResult& r, float through) {
+      const TranslucentHit& e = in.translucent_[saturated_at];
+      r.hit = TraceHit{TraceHit::Kind::kAmalgam, e.t, e.id, e.level, e.surf};
+      const float scale = 1.0f / (1.0f - through);
+      for (Member& m : in.members_) m.w *= scale;
+      r.normal = r.normal * scale;
+      r.albedo = r.albedo * scale;
+    }
+    void end_primitive(SampleResult&, const TraceHit& hit, const Surface& surf, Vec3 n,
+                       float through) {
+      hit_surface = surf;
+      hit_normal = n;
+      in.members_.push_back(
+          {through, in.template direct<false, false>(primary, hit.surf, n, surf, key, none), -1});
+    }
+    void end_amalgam(SampleResult&, const TraceHit& hit, const Appearance& app, float through) {
+      in.members_.push_back(
+          {through, in.template shade<false>(primary, hit.id, app, hit.surf, key, none), -1});
+    }
+    void finish(SampleResult& r, const TraceHit& hit) {
+      auto lum = [](Vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; };
+      const std::vector<Member>& ms = in.members_;
+      float total = 0.0f;
+      for (const Member& m : ms) total += m.w * lum(m.u);
+      if (!(total > 0.0f)) return;  // nothing lit even without shadows
+      float x = to_unit_float(hash_combine(key, 0x636f6d70)) * total;  // which member
+      std::size_t j = 0;
+      while (j + 1 < ms.size() && x >= ms[j].w * lum(ms[j].u)) x -= ms[j].w * lum(ms[j].u), ++j;
+      const Member& m = ms[j];
+      const float p = m.w * lum(m.u) / total;
+      if (!(p > 0.0f)) return;
+      std::uint64_t stream = 1;
+      Vec3 d;
+      if (m.k >= 0) {
+        const TranslucentHit& a = in.translucent_[static_cast<std::size_t>(m.k)];
+        d = in.shade(primary, a.id, in.h_.appearance(a.id), a.surf, key, stream);
+      } else if (hit.kind == TraceHit::Kind::kPrimitive) {
+        d = in.direct(primary, hit.surf, hit_normal, hit_surface, key, stream);
+      } else {
+        d = in.shade(primary, hit.id, in.h_.appearance(hit.id), hit.surf, key, stream);
+      }
+      r.colour += d * (m.w / p);
+    }
+  };
 
   /// Reflectance x cosine of a cloud of isotropically oriented Lambertian facets (uniform
   /// normals over the sphere, as on a sphere or any convex body with that normal
@@ -316,7 +358,7 @@ class Integrator {
   const Environment& env_;
   Tracer trav_;
   std::vector<TranslucentHit> translucent_;
-  /// A member of a composite (li_composite): its weight, unshadowed radiance, and index in
+  /// A member of a composite (OneMemberShadowed): its weight, unshadowed radiance, and index in
   /// translucent_ (-1: the hit).
   struct Member {
     float w;
