@@ -461,7 +461,30 @@ TEST(SimdTraversal, InstancedMatchesReference) {
   BuildConfig tc;
   tc.parallel = false;
   const InstancedHierarchy h = build_instanced(std::move(meshes), std::move(instances), tc);
-  compare_all(h, random_rays(h.bounds(h.root()), 1500, 23), h.levels, "instanced");
+  const std::vector<Ray> rays = random_rays(h.bounds(h.root()), 1500, 23);
+  ASSERT_NE(h.top_wide_nodes(), nullptr);
+  compare_all(h, rays, h.levels, "instanced");
+
+  // A mesh left without its SIMD form by design (more records than references address; here
+  // simulated): the instanced source cannot walk it, so the whole hierarchy goes to the
+  // generic source, with the same hits and counts.
+  InstancedHierarchy big = h;
+  big.meshes[0].wide = WideNodes{};
+  big.meshes[0].wide.unaddressable_nodes = big.meshes[0].nodes.size();
+  build_wide(big);
+  EXPECT_EQ(big.meshes[0].wide_nodes(), nullptr) << "a mesh left out by design is not rebuilt";
+  EXPECT_EQ(big.top_wide_nodes(), nullptr);
+  EXPECT_FALSE(big.wide_stale());
+  compare_all(big, rays, big.levels, "instanced, a mesh without SIMD form");
+
+  // A top tree whose SIMD form is missing is refused, not walked slowly.
+  InstancedHierarchy stale = h;
+  stale.top_wide = WideNodes{};
+  EXPECT_TRUE(stale.wide_stale());
+  Counters unused;
+  EXPECT_THROW(
+      (Traversal<InstancedHierarchy, TraditionalLod, StochasticOpacity>(stale, {}, unused)),
+      InternalError);
 }
 
 }  // namespace

@@ -106,9 +106,16 @@ class InstancedHierarchy {
   }
   HierarchyInfo info() const;
   /// The top tree's SIMD form when `build_wide` has built it (and with it every mesh's), else
-  /// null: the traversal's generic path.
+  /// null: the traversal's generic source.
   const WideNodes* top_wide_nodes() const {
     return !top_nodes.empty() && top_wide.headers.size() == top_nodes.size() ? &top_wide : nullptr;
+  }
+  /// As ExplicitHierarchy::wide_stale for the top tree: its SIMD form missing (never built, or
+  /// the top tree changed since) although `build_wide` did not leave it out by design (a mesh or
+  /// the top tree with more records than references address).
+  bool wide_stale() const {
+    return !top_nodes.empty() && !top_wide_nodes() &&
+           top_wide.unaddressable_nodes != top_nodes.size();
   }
   /// The primitive in world space (for flatten() and tests).
   Primitive primitive(PrimId p) const;

@@ -137,10 +137,18 @@ void build_wide(ExplicitHierarchy& h) {
 
 void build_wide(InstancedHierarchy& h) {
   for (ExplicitHierarchy& m : h.meshes)
-    if (!m.wide_nodes()) build_wide(m);
+    if (m.wide_stale()) build_wide(m);
   WideNodes& w = h.top_wide;
   w = WideNodes{};
   const std::size_t n = h.top_nodes.size();
+  // The instanced source reads every mesh's SIMD form: without one (a mesh of more records than
+  // references address), the whole hierarchy goes to the generic source.
+  for (const ExplicitHierarchy& m : h.meshes) {
+    if (!m.nodes.empty() && !m.wide_nodes()) {
+      w.unaddressable_nodes = n;
+      return;
+    }
+  }
   w.headers.assign(n, WideHeader{});
   for (std::size_t i = 0; i < n; ++i) {
     const ExplicitNode& nd = h.top_nodes[i];
@@ -150,6 +158,7 @@ void build_wide(InstancedHierarchy& h) {
   const std::size_t n_records = assign_records(w.headers, [](std::size_t) { return true; });
   if (n_records == 0) {
     w = WideNodes{};
+    w.unaddressable_nodes = n;
     return;
   }
   const auto ref = [&](std::uint32_t j) {

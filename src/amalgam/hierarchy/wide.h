@@ -171,8 +171,9 @@ struct WideNodes {
 /// (Re)builds `h.wide` from `h.nodes` and packs `h.prims` (unpacking them first if packed).
 void build_wide(ExplicitHierarchy& h);
 
-/// (Re)builds `h.top_wide` from `h.top_nodes`, and the `WideNodes` of every mesh that has none
-/// (called at the end of `build_instanced`).
+/// (Re)builds `h.top_wide` from `h.top_nodes`, and the `WideNodes` of every mesh whose form is
+/// stale (called at the end of `build_instanced`). Leaves the top tree without SIMD form (the
+/// traversal's generic source) when a mesh has none by design.
 void build_wide(InstancedHierarchy& h);
 
 }  // namespace amalgam
