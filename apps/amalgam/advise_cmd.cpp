@@ -97,17 +97,6 @@ void paste(Canvas& c, const std::vector<Vec3>& px, int w, int h, int x0, int y0)
     for (int x = 0; x < w; ++x) c.at(x0 + x, y0 + y) = px[static_cast<std::size_t>(y) * w + x];
 }
 
-std::vector<Vec3> level_colours(const RenderOutput& r, int max_level) {
-  std::vector<Vec3> img(r.level.size());
-  for (std::size_t i = 0; i < img.size(); ++i) {
-    const float l = r.level[i];
-    img[i] = l == kLevelNothing     ? Vec3{0, 0, 0}
-             : l == kLevelPrimitive ? Vec3{0.6f, 0.6f, 0.6f}
-                                    : viridis(max_level > 0 ? l / max_level : 0.0);
-  }
-  return img;
-}
-
 /// Columns: the reference, then each renderer. Rows: the image with its name and figures,
 /// the cost per sample on one log scale, the level rendered; legends for both below.
 Canvas strip(const RenderOutput& ref, const std::vector<Measured>& ms, int max_level, int ref_spp) {
@@ -157,7 +146,8 @@ Canvas strip(const RenderOutput& ref, const std::vector<Measured>& ms, int max_l
   legend.height = bar_h;
   append_labels(legend, log_bar_labels(range, c.width),
                 "middle row: intersection tests per sample, log scale", "tests/sample (log)");
-  const Canvas levels = with_level_legend({}, c.width, 0, max_level, {0.6f, 0.6f, 0.6f}, {});
+  const Canvas levels =
+      with_level_legend({}, c.width, 0, max_level, kLevelPrimitiveColour, kLevelNothingColour);
   for (const Canvas* part : std::initializer_list<const Canvas*>{&legend, &levels}) {
     const int y0 = c.height;
     c.height += part->height;

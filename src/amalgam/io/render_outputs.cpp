@@ -98,23 +98,25 @@ void write_cost_image(const std::string& path, const RenderOutput& r, const LogR
   write_image(path, r.width, r.height, grey(raw));
 }
 
+std::vector<Vec3> level_colours(const RenderOutput& r, int max_level) {
+  std::vector<Vec3> img(r.level.size());
+  for (std::size_t i = 0; i < img.size(); ++i) {
+    const float l = r.level[i];
+    img[i] = l == kLevelNothing     ? kLevelNothingColour
+             : l == kLevelPrimitive ? kLevelPrimitiveColour
+                                    : viridis(max_level > 0 ? l / max_level : 0.0);
+  }
+  return img;
+}
+
 void write_level_image(const std::string& path, const RenderOutput& r, int max_level) {
   if (!is_png_path(path)) {
     write_image(path, r.width, r.height, grey(r.level));
     return;
   }
-  const Vec3 nothing{0, 0, 0}, primitive{0.6f, 0.6f, 0.6f};
-  std::vector<Vec3> img(r.level.size());
-  for (std::size_t i = 0; i < img.size(); ++i) {
-    const float l = r.level[i];
-    if (l == kLevelNothing)
-      img[i] = nothing;
-    else if (l == kLevelPrimitive)
-      img[i] = primitive;
-    else
-      img[i] = viridis(max_level > 0 ? l / max_level : 0.0);
-  }
-  const Canvas c = with_level_legend(img, r.width, r.height, max_level, primitive, nothing);
+  const std::vector<Vec3> img = level_colours(r, max_level);
+  const Canvas c = with_level_legend(img, r.width, r.height, max_level, kLevelPrimitiveColour,
+                                     kLevelNothingColour);
   write_image(path, c.width, c.height, c.pixels,
               {{"Software", std::string("amalgam ") + version()},
                {"amalgam:level-range", "0," + std::to_string(max_level)},

@@ -29,6 +29,12 @@ double write_render_exr(const std::string& path, const RenderOutput& r, const Im
 /// as tEXt metadata; .pfm/.exr the raw mean tests per sample, grey.
 void write_cost_image(const std::string& path, const RenderOutput& r, const LogRange& range);
 
+/// The colours of the rendered-level picture: levels in viridis from level 0 to `max_level`
+/// (linear), primitives light grey, nothing black.
+inline constexpr Vec3 kLevelPrimitiveColour{0.6f, 0.6f, 0.6f};
+inline constexpr Vec3 kLevelNothingColour{0, 0, 0};
+std::vector<Vec3> level_colours(const RenderOutput& r, int max_level);
+
 /// The rendered-level image: .png in viridis from level 0 to `max_level` (linear), primitives
 /// light grey, nothing black; .pfm/.exr the raw level (kLevelPrimitive, kLevelNothing), grey.
 void write_level_image(const std::string& path, const RenderOutput& r, int max_level);
