@@ -74,6 +74,7 @@ struct Scene {
     std::shared_ptr<const Tracer> tracer = tracer_for(opt.o);
     // Another view of the same built, baked scene: only the environment is new.
     CameraChoice view;
+    view.spelling = OptionSpelling::kKeywords;  // messages name keywords
     const std::pair<const char*, const py::object*> keys[] = {
         {"camera", &camera}, {"eye", &eye}, {"look_at", &look_at},
         {"up", &up},         {"fov", &fov}, {"light_samples", &light_samples}};
@@ -181,6 +182,7 @@ std::shared_ptr<Scene> load(const std::string& spec, const py::kwargs& params) {
   // the others are builtin parameters (--set key=value).
   Params p(spec);
   CameraChoice view;
+  view.spelling = OptionSpelling::kKeywords;  // messages name keywords
   SceneFileConfig config;
   for (auto item : params) {
     const std::string key = py::str(item.first).cast<std::string>();

@@ -140,11 +140,22 @@ def test_bad_view_keywords_are_value_errors(cli, tmp_path):
     assert str(e.value) == message
     with pytest.raises(ValueError, match="^eye='"):
         amalgam.load("builtin:demo", eye=(1, 2))
-    with pytest.raises(ValueError, match="--camera"):
+    # The loader's view messages name keywords too, with the CLI's words.
+    camera_message, _ = cli_message(cli, "render", "builtin:demo", "--camera", "nope", "--out",
+                                    str(tmp_path / "x.pfm"))
+    assert camera_message.startswith("--camera nope: ")
+    with pytest.raises(ValueError) as e:
         amalgam.load("builtin:demo", camera="nope")
+    expected = camera_message.replace("--camera nope", "camera=nope")
+    for flag in ("eye", "look-at", "up", "fov"):
+        expected = expected.replace("--" + flag, flag.replace("-", "_") + "=")
+    assert str(e.value) == expected
+    assert "--" not in str(e.value)
     scene = amalgam.load("builtin:demo")
     with pytest.raises(ValueError) as e:
         scene.render(width=4, height=4, spp=1, fov=200)
     assert str(e.value) == message
-    with pytest.raises(ValueError, match="--up"):
+    with pytest.raises(ValueError, match="^up=: the up vector"):
         scene.render(width=4, height=4, spp=1, up=(0, 0, 1), eye=(0, 0, 3), look_at=(0, 0, 0))
+    with pytest.raises(ValueError, match="^eye=/look_at=: the eye is at the look-at point"):
+        scene.render(width=4, height=4, spp=1, eye=(1, 1, 1), look_at=(1, 1, 1))

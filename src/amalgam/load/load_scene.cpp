@@ -7,6 +7,7 @@
 
 #include "amalgam/io/json_reader.h"
 #include "amalgam/io/mesh_import.h"
+#include "amalgam/render/option_rules.h"
 #include "amalgam/scene/coordinate_limit.h"
 #include "amalgam/scene/framing.h"
 #include "amalgam/util/file_kind.h"
@@ -118,6 +119,9 @@ Bbox scene_bounds(const LoadedScene& scene) {
 }  // namespace
 
 Environment chosen_view(const LoadedScene& scene, const CameraChoice& choice) {
+  const auto name = [&](std::string_view flag, const std::string& value = {}) {
+    return option_text(flag, choice.spelling, value);
+  };
   Camera c = scene.env.camera;
   if (!choice.camera.empty()) {
     const std::string& want = choice.camera;
@@ -133,10 +137,11 @@ Environment chosen_view(const LoadedScene& scene, const CameraChoice& choice) {
         std::stoul(want) < scene.cameras.size())
       found = &scene.cameras[std::stoul(want)];
     if (!found)
-      throw InputError("--camera " + one_line(want, 60) + ": " +
+      throw InputError(name("--camera", one_line(want, 60)) + ": " +
                        (scene.cameras.empty()
-                            ? scene.name + " defines no cameras (--eye, --look-at, --up and "
-                                           "--fov set the view of any scene)"
+                            ? scene.name + " defines no cameras (" + name("--eye") + ", " +
+                                  name("--look-at") + ", " + name("--up") + " and " +
+                                  name("--fov") + " set the view of any scene)"
                             : "no such camera in " + scene.name + " (cameras: " + list + ")"));
     c = found->camera;
   }
@@ -145,7 +150,7 @@ Environment chosen_view(const LoadedScene& scene, const CameraChoice& choice) {
   if (choice.up) c.up = *choice.up;
   if (choice.fov_deg) {
     if (!(*choice.fov_deg > 0.0f && *choice.fov_deg < 180.0f))
-      throw InputError("--fov " + JsonReader::format(*choice.fov_deg) +
+      throw InputError(name("--fov", JsonReader::format(*choice.fov_deg)) +
                        ": expected a vertical field of view in degrees, > 0 and < 180");
     c.vfov_deg = *choice.fov_deg;
   }
@@ -156,16 +161,17 @@ Environment chosen_view(const LoadedScene& scene, const CameraChoice& choice) {
     c = frame_camera(scene_bounds(scene), c.vfov_deg, *choice.up);
   const Vec3 dir = c.look_at - c.position;
   if (!(length(dir) > 0.0f))
-    throw InputError("--eye/--look-at: the eye is at the look-at point (no view direction)");
+    throw InputError(name("--eye") + "/" + name("--look-at") +
+                     ": the eye is at the look-at point (no view direction)");
   if (!(length(cross(normalize(dir), c.up)) > 1e-6f * length(c.up)))
-    throw InputError("--up: the up vector is zero or along the view direction");
+    throw InputError(name("--up") + ": the up vector is zero or along the view direction");
   const bool changed = c.position != scene.env.camera.position ||
                        c.look_at != scene.env.camera.look_at || c.up != scene.env.camera.up ||
                        c.vfov_deg != scene.env.camera.vfov_deg;
   Environment env = scene.env;
   if (choice.light_samples) {
     if (!(*choice.light_samples >= 1 && *choice.light_samples <= 4096))
-      throw InputError("--light-samples " + std::to_string(*choice.light_samples) +
+      throw InputError(name("--light-samples", std::to_string(*choice.light_samples)) +
                        ": expected an integer in [1, 4096]");
     for (Light& l : env.lights)
       if (l.sized()) l.samples = *choice.light_samples;

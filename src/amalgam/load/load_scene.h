@@ -10,6 +10,7 @@
 #include "amalgam/hierarchy/build/build.h"
 #include "amalgam/io/scene_json.h"
 #include "amalgam/render/loaded_scene.h"
+#include "amalgam/render/options.h"
 
 namespace amalgam {
 
@@ -32,8 +33,11 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
 struct CameraChoice {
   std::string camera;  ///< a name, else a 0-based index, of LoadedScene::cameras; empty: default
   std::optional<Vec3> eye, look_at, up;
-  std::optional<float> fov_deg;  ///< vertical field of view
+  std::optional<float> fov_deg;        ///< vertical field of view
   std::optional<int> light_samples{};  ///< replaces Light::samples of every sized light
+  /// How error messages name the view options: the CLI's flags (`--up`) or Python's keywords
+  /// (`up=`).
+  OptionSpelling spelling = OptionSpelling::kFlags;
 };
 
 /// Applies `choice` to `scene.env.camera`; default lights (LoadedScene::default_lights) follow
