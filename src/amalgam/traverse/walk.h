@@ -76,8 +76,6 @@ class Walk {
     }
   }
 
-  Source& source() { return source_; }
-
  private:
   template <BoxRays kRays>
   void loop(State& s, const Root& root, float t_root) {
