@@ -10,3 +10,6 @@ cd "$(dirname "$0")/.."
 AMALGAM=${1:-build/amalgam}
 "$AMALGAM" render tests/data/bias-meadow.json --renderer traditional --sampler stratified \
   --spp 1024 --seed 1 --width 128 --height 96 --quiet --out tests/data/bias-meadow-ref.pfm
+# The world cells' crowd (tests/render/world_cells_test.cpp): 64 x 48, 1024 spp, a few seconds.
+"$AMALGAM" render tests/data/crowd.json --renderer traditional --sampler stratified \
+  --spp 1024 --seed 1 --width 64 --height 48 --quiet --out tests/data/crowd-ref.pfm

@@ -192,17 +192,21 @@ TEST(Volumetric, CloseUpIsFullDetail) {
   EXPECT_EQ(v.counters.tests_of(ObjectKind::kCell), 0u);
 }
 
+// One object (its own cells) and a crowd of instances smaller than a pixel (world cells).
 TEST(Volumetric, SameBytesForAnyThreadCount) {
-  const LoadedScene scene =
-      load_objects(std::string(AMALGAM_SOURCE_DIR) + "/scenes/volumetric/tree.json");
-  RenderOptions o = volumetric(40, 30, 3);
-  o.threads = 1;
-  const RenderOutput one = render(scene, o);
-  o.threads = 2;
-  const RenderOutput two = render(scene, o);
-  EXPECT_EQ(one.image, two.image);
-  EXPECT_EQ(one.tests, two.tests);
-  EXPECT_EQ(one.counters.total(), two.counters.total());
+  for (const char* path : {"/scenes/volumetric/tree.json", "/tests/data/crowd.json"}) {
+    SCOPED_TRACE(path);
+    const LoadedScene scene = load_objects(std::string(AMALGAM_SOURCE_DIR) + path);
+    RenderOptions o = volumetric(40, 30, 3);
+    o.threads = 1;
+    const RenderOutput one = render(scene, o);
+    o.threads = 2;
+    const RenderOutput two = render(scene, o);
+    EXPECT_EQ(one.image, two.image);
+    EXPECT_EQ(one.tests, two.tests);
+    EXPECT_EQ(one.counters.total(), two.counters.total());
+    EXPECT_GT(one.counters.tests_of(ObjectKind::kCell), 0u);
+  }
 }
 
 }  // namespace

@@ -40,6 +40,10 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
     j["volumes"] = {{"cells", scene.volumes->cells()},
                     {"bytes", scene.volumes->bytes()},
                     {"levels", scene.volumes->config.levels},
+                    {"world_cells", scene.volumes->world.cells()},
+                    {"world_levels", scene.volumes->world.levels},
+                    {"world_bytes", scene.volumes->world.bytes()},
+                    {"world_bake_s", scene.volumes->world_seconds},
                     {"bake_s", scene.volume_seconds}};
   j["scene"] = {{"name", scene.name},
                 {"primitives", count(info.primitives)},

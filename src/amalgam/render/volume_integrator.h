@@ -27,6 +27,7 @@
 #include <numbers>
 #include <vector>
 
+#include "amalgam/render/cell_shading.h"
 #include "amalgam/render/integrator.h"
 #include "amalgam/traverse/object_lod.h"
 
@@ -54,7 +55,10 @@ class VolumeIntegrator final : private DeferSink {
     lod.self = 0, lod.self_full = false, lod.defer_inside = false;
     objects_.clear();
     segs_.clear();
-    const TraceHit hit = trav_.intersect(primary, hash_combine(key, 0));
+    const std::uint64_t walk_key = hash_combine(key, 0);
+    Ray camera = primary;
+    world_camera(camera, walk_key);
+    const TraceHit hit = trav_.intersect(camera, walk_key);
     const float t_end = hit.kind == TraceHit::Kind::kNone ? kInfinity : hit.t;
 
     // Composite front to back what lies before the full-detail hit. Each member is shaded
@@ -94,20 +98,7 @@ class VolumeIntegrator final : private DeferSink {
     } else if (through > 0.0f) {
       r.colour += env_.seen_toward(primary.dir) * through;
     }
-    float amalgam_weight = 0.0f;
-    for (const Member& m : members_) {
-      const Segment& s = segs_[static_cast<std::size_t>(m.seg)];
-      const Object& ob = objects_[s.obj];
-      r.albedo += ob.g->surface[s.cell].albedo * m.w;
-      r.normal += cell_normal(ob, s.cell) * m.w;
-      amalgam_weight += m.w;
-    }
-    if (!members_.empty() && amalgam_weight >= through) {
-      const Member& m = members_.front();
-      const Object& ob = objects_[segs_[static_cast<std::size_t>(m.seg)].obj];
-      r.hit = TraceHit{TraceHit::Kind::kAmalgam, m.t, IH::id(ob.slot, 0),
-                       ob.root_level + 1 + ob.level, SurfaceHit{}};
-    }
+    blend_outputs(primary.dir, through, r);
     if (members_.empty() && !end_lit) return r;
 
     // Lights: for each light sample, every member's unshadowed radiance, then one shadow query
@@ -130,6 +121,8 @@ class VolumeIntegrator final : private DeferSink {
  private:
   /// Below this transmittance a ray ends: nothing behind can show.
   static constexpr float kOpaque = 1e-4f;
+  /// Segment::obj of a world cell of level L: kWorld + L.
+  static constexpr std::uint32_t kWorld = 0xffffff00u;
 
   struct Object {
     std::uint64_t slot;  ///< instance index + 1
@@ -142,7 +135,7 @@ class VolumeIntegrator final : private DeferSink {
   struct Segment {
     float t0, t1;
     std::uint32_t cell;
-    std::uint32_t obj;
+    std::uint32_t obj;  ///< index in objects_, or kWorld + level: a world cell
     float alpha;
   };
   struct Member {
@@ -183,6 +176,8 @@ class VolumeIntegrator final : private DeferSink {
   /// transmittance by the instance's and ends once nothing passes.
   void deferred(NodeId root, int level, float t, Ray& ray, std::uint64_t key, bool shadow,
                 bool& done, float& transmittance) override {
+    if (IH::slot(root) == 0 || trav_.lod().absorbed(root, ray, t, key))
+      return;  // the world cells stand for it (world_camera, world_shadow)
     Object ob = object_of(root, level, t, ray, key);
     float t0 = ray.tmin, t1 = ray.tmax;
     if (!clip_to_grid(*ob.g, ob.ray.origin, ob.ray.dir, t0, t1)) return;
@@ -225,6 +220,88 @@ class VolumeIntegrator final : private DeferSink {
     }
   }
 
+  /// The members' share of the albedo and normal outputs, and the hit output: the nearest
+  /// member when the members outweigh what is left (`through`) behind them.
+  void blend_outputs(Vec3 dir, float through, SampleResult& r) const {
+    float amalgam_weight = 0.0f;
+    for (const Member& m : members_) {
+      const Segment& s = segs_[static_cast<std::size_t>(m.seg)];
+      if (s.obj >= kWorld) {
+        r.albedo += v_.world.surface[s.cell].albedo * m.w;
+        r.normal += world_normal(s.cell, dir) * m.w;
+      } else {
+        const Object& ob = objects_[s.obj];
+        r.albedo += ob.g->surface[s.cell].albedo * m.w;
+        r.normal += cell_normal(ob, s.cell) * m.w;
+      }
+      amalgam_weight += m.w;
+    }
+    if (!members_.empty() && amalgam_weight >= through) {
+      const Member& m = members_.front();
+      const Segment& s = segs_[static_cast<std::size_t>(m.seg)];
+      if (s.obj >= kWorld) {
+        r.hit = TraceHit{TraceHit::Kind::kAmalgam, m.t, IH::id(0, 0),
+                         static_cast<int>(s.obj - kWorld), SurfaceHit{}};
+      } else {
+        const Object& ob = objects_[s.obj];
+        r.hit = TraceHit{TraceHit::Kind::kAmalgam, m.t, IH::id(ob.slot, 0),
+                         ob.root_level + 1 + ob.level, SurfaceHit{}};
+      }
+    }
+  }
+
+  /// The world cells along camera ray `ray` (walk key `walk_key`), front to back, into the
+  /// blend; lowers the ray's tmax to where they alone saturate it.
+  void world_camera(Ray& ray, std::uint64_t walk_key) {
+    const WorldCells& w = v_.world;
+    if (w.empty()) return;
+    const OctahedralLerp lerp = OctahedralLerp::of(ray.dir, w.dir_res);
+    Counters& counters = trav_.counters();
+    float left = 1.0f;
+    march_world(
+        w, ray, ray.tmin, ray.tmax, trav_.lod().cell_pixels, world_level_u(walk_key),
+        [&](std::uint32_t cell, float a, float b, int level) {
+          const float alpha = 1.0f - std::exp(-w.sigma_of(cell, lerp) * (b - a));
+          if (alpha > 0.0f)
+            segs_.push_back({a, b, cell, kWorld + static_cast<std::uint32_t>(level), alpha});
+          left *= 1.0f - alpha;
+          if (left > kOpaque) return true;
+          ray.tmax = std::min(ray.tmax, a);
+          return false;
+        },
+        [&](int level, int steps) {
+          counters.count_tests(RayKind::kPrimary, ObjectKind::kCell, level,
+                               static_cast<std::uint64_t>(steps));
+        });
+  }
+
+  /// The transmittance of the world cells along shadow ray `ray` (keyed `key`), with a hot spot
+  /// as in shadow_march but as wide as the cells' grain, not the cone: the instances in a world
+  /// cell are smaller than the cone, and the gap a camera ray came through is as wide as their
+  /// pieces (a blade, a leaf). A chord attenuates by its distance from the camera ray over two
+  /// grains (at most 1): a linear ramp with the integral of a correlation exp(-distance /
+  /// grain) (docs/volumetric.md, "World cells").
+  float world_shadow(const Ray& ray, std::uint64_t key) {
+    const WorldCells& w = v_.world;
+    if (w.empty()) return 1.0f;
+    const OctahedralLerp lerp = OctahedralLerp::of(ray.dir, w.dir_res);
+    Counters& counters = trav_.counters();
+    float tr = 1.0f;
+    march_world(
+        w, ray, ray.tmin, ray.tmax, trav_.lod().cell_pixels, world_level_u(key),
+        [&](std::uint32_t cell, float a, float b, int) {
+          const float beside = std::min(
+              1.0f, 0.5f * (a + b) * query_.sin_apart / std::max(2.0f * w.grain[cell], 1e-30f));
+          tr *= std::exp(-w.sigma_of(cell, lerp) * (b - a) * beside);
+          return tr > kOpaque;
+        },
+        [&](int level, int steps) {
+          counters.count_tests(RayKind::kShadow, ObjectKind::kCell, level,
+                               static_cast<std::uint64_t>(steps));
+        });
+    return tr > kOpaque ? tr : 0.0f;
+  }
+
   /// The transmittance of object `ob` along shadow ray `ray` over [t0, t1] (clipped to its
   /// grid): the product of 1 - coverage (seen from the light) over its cells crossed. A cell
   /// that holds the ray's origin attenuates it by the share of the cell's mean chord still
@@ -263,15 +340,8 @@ class VolumeIntegrator final : private DeferSink {
   /// The cell's mean normal as seen (for the normal output), in world space.
   Vec3 cell_normal(const Object& ob, std::uint32_t cell) const {
     const CellGrid& g = *ob.g;
-    const int nb = g.normal_bins();
-    const std::uint16_t* hist = g.normals.data() + static_cast<std::size_t>(cell) * nb;
-    const Vec3 o = -ob.dir;
-    Vec3 sum{};
-    for (int k = 0; k < nb; ++k) {
-      const Vec3 m = g.normal_dirs[static_cast<std::size_t>(k)];
-      const float c = dot(m, o);
-      if (g.oriented ? c > 0.0f : c != 0.0f) sum += (c < 0 ? -m : m) * (hist[k] * std::fabs(c));
-    }
+    Vec3 sum = seen_normal(g.normals.data() + static_cast<std::size_t>(cell) * g.normal_bins(),
+                           g.normal_dirs, g.oriented, -ob.dir);
     const IH::InstanceData& in = h_.instances[ob.slot - 1];
     if (!in.identity)
       sum = Vec3{dot(in.normal_rows[0], sum), dot(in.normal_rows[1], sum),
@@ -280,44 +350,25 @@ class VolumeIntegrator final : private DeferSink {
     return len > 0.0f ? sum / len : Vec3{};
   }
 
+  /// World cell `cell`'s mean normal seen along world direction `dir`.
+  Vec3 world_normal(std::uint32_t cell, Vec3 dir) const {
+    const WorldCells& w = v_.world;
+    const Vec3 sum =
+        seen_normal(w.normals.data() + static_cast<std::size_t>(cell) * w.normal_bins(),
+                    w.normal_dirs, false, -dir);
+    const float len = length(sum);
+    return len > 0.0f ? sum / len : Vec3{};
+  }
+
   /// Radiance toward the viewer per unit of the cell's weight, lit from world direction `wi`
   /// with irradiance `e`, without shadows (for a closed object, with its own).
   Vec3 cell_radiance(const Object& ob, std::uint32_t cell, Vec3 wi, Vec3 e) const {
-    constexpr float inv_pi = std::numbers::inv_pi_v<float>;
     const CellGrid& g = *ob.g;
     const CellSurface& s = g.surface[cell];
-    const Vec3 o = -ob.dir, l = to_object(ob.slot, wi);
-    const int nb = g.normal_bins();
-    const std::uint16_t* hist = g.normals.data() + static_cast<std::size_t>(cell) * nb;
-    const bool spec = s.reflectance > 0.0f;
-    const Vec3 half = spec ? normalize(o + l) : Vec3{};
-    float seen = 0.0f, diffuse = 0.0f, specular = 0.0f, facing_light = 0.0f;
-    for (int k = 0; k < nb; ++k) {
-      if (!hist[k]) continue;
-      const float hk = static_cast<float>(hist[k]);
-      Vec3 m = g.normal_dirs[static_cast<std::size_t>(k)];
-      const float co = dot(m, o), cl = dot(m, l);
-      float w, lit;
-      if (g.oriented) {
-        w = std::max(co, 0.0f);
-        lit = std::max(cl, 0.0f);
-        facing_light += hk * lit;
-      } else {
-        w = std::fabs(co);
-        if (co < 0.0f) m = -m;
-        lit = std::max(co < 0.0f ? -cl : cl, 0.0f);
-      }
-      seen += hk * w;
-      diffuse += hk * w * lit;
-      if (spec && lit > 0.0f)
-        specular += hk * w * lit * std::pow(std::max(0.0f, dot(m, half)), g.shininess);
-    }
-    if (!(seen > 0.0f)) return {};
-    Vec3 f = s.albedo * (inv_pi * diffuse / seen);
-    if (spec) {
-      const float lobe = s.reflectance * (g.shininess + 8.0f) * (inv_pi / 8.0f) * (specular / seen);
-      f += Vec3{lobe, lobe, lobe};
-    }
+    const Vec3 l = to_object(ob.slot, wi);
+    float facing_light;
+    Vec3 f = reflected(g.normals.data() + static_cast<std::size_t>(cell) * g.normal_bins(),
+                       g.normal_dirs, g.oriented, s, g.shininess, -ob.dir, l, facing_light);
     if (g.oriented) {
       // A closed object shadows itself as a solid: its surfaces in the cell facing the light
       // are lit where they are the first surfaces the light meets, i.e. the share of their
@@ -328,6 +379,17 @@ class VolumeIntegrator final : private DeferSink {
       f = f * std::min(1.0f, reached / (s.area * facing_light * (1.0f / 65535.0f)));
     }
     return f * e;
+  }
+
+  /// The radiance of segment `s`'s cell (an object's or a world cell) toward the viewer along
+  /// camera direction `dir`, as cell_radiance.
+  Vec3 segment_radiance(const Segment& s, Vec3 dir, Vec3 wi, Vec3 e) const {
+    if (s.obj < kWorld) return cell_radiance(objects_[s.obj], s.cell, wi, e);
+    const WorldCells& w = v_.world;
+    float facing_light;
+    return reflected(w.normals.data() + static_cast<std::size_t>(s.cell) * w.normal_bins(),
+                     w.normal_dirs, false, w.surface[s.cell], w.shininess, -dir, wi, facing_light) *
+           e;
   }
 
   /// The light sample (u1, u2) of `light` seen from `p`; false if it brings nothing.
@@ -350,7 +412,7 @@ class VolumeIntegrator final : private DeferSink {
       const Vec3 p = primary.at(m.t);
       LightSample ls;
       if (!light_sample(light, p, Vec3{}, samples, u1, u2, ls)) continue;
-      const Vec3 u = cell_radiance(objects_[s.obj], s.cell, ls.wi, ls.e);
+      const Vec3 u = segment_radiance(s, primary.dir, ls.wi, ls.e);
       if (luminance(u) > 0.0f) lits_.push_back({u, p, ls, m.w, m.seg});
     }
     if (end_lit) {
@@ -384,14 +446,15 @@ class VolumeIntegrator final : private DeferSink {
       shadow.cone_spread = (c.ls.end_width - shadow.cone_width) / std::max(c.ls.dist, 1e-30f);
     else
       shadow.cone_spread = c.ls.spread;
-    query_.self =
-        from_cell ? objects_[segs_[static_cast<std::size_t>(c.seg)].obj].slot : IH::slot(hit.id);
+    const std::uint32_t from_obj = from_cell ? segs_[static_cast<std::size_t>(c.seg)].obj : 0;
+    query_.self = !from_cell ? IH::slot(hit.id) : from_obj < kWorld ? objects_[from_obj].slot : 0;
     query_.self_full = !from_cell;
     const float cos_apart = std::clamp(dot(wo, c.ls.wi), -1.0f, 1.0f);
     query_.sin_apart = std::sqrt(std::max(0.0f, 1.0f - cos_apart * cos_apart));
     ObjectLod& lod = trav_.lod();
     lod.self = query_.self, lod.self_full = query_.self_full, lod.defer_inside = true;
-    const float tr = trav_.transmittance(shadow, key);
+    float tr = world_shadow(shadow, key);
+    if (tr > 0.0f) tr *= trav_.transmittance(shadow, key);
     lod.self = 0, lod.self_full = false, lod.defer_inside = false;
     if (tr > 0.0f) colour += c.u * (c.w * tr / p);
   }

@@ -5,7 +5,9 @@
 /// instance is *deferred*: recorded with the depth where the ray enters it, not descended, and
 /// marched through its cells afterwards (render/volume_integrator.h); else the walk descends
 /// and traces its triangles. The switch is per whole object, never inside one, so a ray never
-/// composites part of an object as cells and part as triangles.
+/// composites part of an object as cells and part as triangles. Before that, an instance (or a
+/// top-tree node whose every instance) is absorbed into the world cells at the level the ray's
+/// cone reads there (world_cells.h) is culled: the world cells stand for it.
 
 #include <cstdint>
 
@@ -44,14 +46,30 @@ struct ObjectLod {
     return choose_cell_level(g, width, cell_pixels, level_choice_u(key, slot));
   }
 
-  /// Defer node `id` (entered at t by ray r keyed `key`)?
+  /// Whether node `id` (a top-tree node or an instance root), entered at t by ray r keyed
+  /// `key`, is absorbed into the world cells the ray reads there. Consistent down the tree: a
+  /// node's instances are entered no nearer, where the level read is no finer.
+  bool absorbed(NodeId id, const Ray& r, float t, std::uint64_t key) const {
+    const WorldCells& w = volumes->world;
+    if (w.empty()) return false;
+    const std::uint64_t slot = InstancedHierarchy::slot(id);
+    const int a = slot == 0                            ? w.top_absorb[id]
+                  : InstancedHierarchy::local(id) == 0 ? w.absorb[slot - 1]
+                                                       : -1;
+    return a >= 0 && w.level_at(r.footprint(t), cell_pixels, world_level_u(key)) <= a;
+  }
+
+  /// Defer node `id` (entered at t by ray r keyed `key`)? Absorbed nodes are deferred too
+  /// (and passed by the sink).
   bool render_node(NodeId id, const Bbox&, int, const Ray& r, float t, bool inside,
                    std::uint64_t key) const {
     const std::uint64_t slot = InstancedHierarchy::slot(id);
-    if (slot == 0 || InstancedHierarchy::local(id) != 0) return false;
+    const bool root = slot != 0 && InstancedHierarchy::local(id) == 0;
+    if (root && slot == self) return !self_full;
+    if (absorbed(id, r, t, key)) return true;
+    if (!root) return false;
     const CellGrid* g = volumes->grid(h->instances[slot - 1].mesh);
     if (!g) return false;
-    if (slot == self) return !self_full;
     if (inside && !defer_inside) return false;
     return level_for(*g, slot, r, t, key) < g->levels;
   }

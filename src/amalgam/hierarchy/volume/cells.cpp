@@ -1,6 +1,7 @@
 #include "amalgam/hierarchy/volume/cells.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -56,6 +57,38 @@ double polygon_area(const Poly& p) {
     sx += c.x, sy += c.y, sz += c.z;
   }
   return 0.5 * std::sqrt(sx * sx + sy * sy + sz * sz);
+}
+
+/// The linear size of the surface's pieces: the triangles joined where they share a vertex
+/// position into connected pieces (a grass blade, a leaf, a whole closed body), the
+/// area-weighted mean of sqrt(piece area). 0 without area.
+float surface_grain(const std::vector<Vec3>& tris) {
+  const std::size_t n = tris.size() / 3;
+  std::vector<std::uint32_t> parent(n);
+  for (std::size_t t = 0; t < n; ++t) parent[t] = static_cast<std::uint32_t>(t);
+  const auto find = [&](std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  // Vertices sorted by position: equal positions adjacent.
+  std::vector<std::pair<std::array<float, 3>, std::uint32_t>> verts;
+  verts.reserve(tris.size());
+  for (std::size_t v = 0; v < tris.size(); ++v)
+    verts.push_back({{tris[v].x, tris[v].y, tris[v].z}, static_cast<std::uint32_t>(v / 3)});
+  std::sort(verts.begin(), verts.end());
+  for (std::size_t v = 1; v < verts.size(); ++v)
+    if (verts[v].first == verts[v - 1].first) {
+      const std::uint32_t a = find(verts[v].second), b = find(verts[v - 1].second);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  std::vector<double> area(n, 0.0);
+  for (std::size_t t = 0; t < n; ++t)
+    area[find(static_cast<std::uint32_t>(t))] +=
+        0.5 * static_cast<double>(
+                  length(cross(tris[3 * t + 1] - tris[3 * t], tris[3 * t + 2] - tris[3 * t])));
+  double sum = 0.0, weighted = 0.0;
+  for (const double a : area) sum += a, weighted += a * std::sqrt(a);
+  return sum > 0.0 ? static_cast<float>(weighted / sum) : 0.0f;
 }
 
 }  // namespace
@@ -158,6 +191,7 @@ CellGrid bake_cells(const ExplicitHierarchy& mesh, const VolumeConfig& config) {
         }
   }
   if (spec_area > 0.0) g.shininess = static_cast<float>(spec_shininess / spec_area);
+  g.grain = surface_grain(tris);
 
   // Coarser levels: each cell the sum of its children. per_level[L][lin] -> accumulator.
   std::vector<std::vector<int>> per_level(static_cast<std::size_t>(g.levels));

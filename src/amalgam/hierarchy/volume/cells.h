@@ -25,6 +25,7 @@
 #include <cmath>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "amalgam/geometry/ray.h"
@@ -52,6 +53,9 @@ struct VolumeConfig {
   /// mesh's first hits buys (docs/volumetric.md); the first-hit coverage is kept either way.
   bool correlated = true;
   bool parallel = true;  ///< oneTBB over the direction bins (the result does not depend on it)
+  /// Bake world cells across the instances too (world_cells.h); false: every instance is
+  /// marched or traced on its own (to measure what world cells buy).
+  bool world = true;
 };
 
 /// The surface inside one cell.
@@ -77,6 +81,10 @@ class CellGrid {
   /// flipped here): surfaces are one-sided and only their outer side can be seen or lit.
   bool oriented = false;
   float shininess = 32.0f;  ///< Blinn-Phong exponent of the specular surfaces (area-weighted)
+  /// The linear size of the mesh's connected pieces (object units; area-weighted mean of the
+  /// square root of each piece's area): how wide the gap a ray came through is, what a shadow
+  /// ray from there stays correlated with (the hot spot of world cells, world_cells.h).
+  float grain = 0.0f;
 
   /// Per level L: its dense index (8^L entries, x fastest) starts at index_offset[L]; an entry
   /// is 0 (no surface there) or the cell's id + 1.
@@ -174,26 +182,35 @@ inline bool clip_to_grid(const CellGrid& g, Vec3 o, Vec3 d, float& t0, float& t1
   return t0 < t1;
 }
 
-/// Calls f(cell, t_in, t_out) for each cell with surface on `level` that the ray o + t d
-/// crosses within [t0, t1] (inside the box, see clip_to_grid), in order of t (a 3D DDA,
-/// Amanatides & Woo 1987), until f returns false. Returns the number of grid cells stepped through,
-/// empty ones included.
+/// One level of a grid of disjoint box cells as a march reads it: the corner `lo` of cell
+/// (0, 0, 0), the cells' size, their counts per axis and the level's dense index (x fastest; an
+/// entry is 0, no content there, or the cell's id + 1).
+struct GridLevelView {
+  Vec3 lo{};
+  Vec3 cell{};
+  int n[3] = {0, 0, 0};
+  const std::uint32_t* index = nullptr;
+};
+
+/// Calls f(cell, t_in, t_out) for each cell with content of grid level `v` that the ray
+/// o + t d crosses within [t0, t1] (inside the level's box), in order of t (a 3D DDA,
+/// Amanatides & Woo 1987), until f returns false. Returns the number of grid cells stepped
+/// through, empty ones included.
 template <class F>
-int march_cells(const CellGrid& g, int level, Vec3 o, Vec3 d, float t0, float t1, F&& f) {
-  const int n = 1 << level;
-  const Vec3 cs = g.cell_size(level);
+int march_level(const GridLevelView& v, Vec3 o, Vec3 d, float t0, float t1, F&& f) {
+  const Vec3 cs = v.cell;
   const Vec3 p = o + d * (0.5f * (t0 + std::min(t1, t0 + 1e-3f * max_component(cs))));
   int c[3], step[3];
   float next[3], delta[3];
   for (int a = 0; a < 3; ++a) {
-    c[a] = std::clamp(static_cast<int>(std::floor((p[a] - g.lo[a]) / cs[a])), 0, n - 1);
+    c[a] = std::clamp(static_cast<int>(std::floor((p[a] - v.lo[a]) / cs[a])), 0, v.n[a] - 1);
     if (d[a] > 0.0f) {
       step[a] = 1;
-      next[a] = (g.lo[a] + cs[a] * static_cast<float>(c[a] + 1) - o[a]) / d[a];
+      next[a] = (v.lo[a] + cs[a] * static_cast<float>(c[a] + 1) - o[a]) / d[a];
       delta[a] = cs[a] / d[a];
     } else if (d[a] < 0.0f) {
       step[a] = -1;
-      next[a] = (g.lo[a] + cs[a] * static_cast<float>(c[a]) - o[a]) / d[a];
+      next[a] = (v.lo[a] + cs[a] * static_cast<float>(c[a]) - o[a]) / d[a];
       delta[a] = -cs[a] / d[a];
     } else {
       step[a] = 0;
@@ -201,21 +218,35 @@ int march_cells(const CellGrid& g, int level, Vec3 o, Vec3 d, float t0, float t1
       delta[a] = kInfinity;
     }
   }
+  const std::size_t nx = static_cast<std::size_t>(v.n[0]);
+  const std::size_t nxy = nx * static_cast<std::size_t>(v.n[1]);
   int steps = 0;
   float t = t0;
   for (;;) {
     ++steps;
     const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
     const float out = std::min(next[a], t1);
-    if (const std::uint32_t cell = g.at(level, c[0], c[1], c[2]); cell && out > t)
+    const std::uint32_t cell =
+        v.index[static_cast<std::size_t>(c[2]) * nxy + static_cast<std::size_t>(c[1]) * nx +
+                static_cast<std::size_t>(c[0])];
+    if (cell && out > t)
       if (!f(cell - 1, t, out)) break;
     if (next[a] >= t1) break;
     t = next[a];
     c[a] += step[a];
-    if (c[a] < 0 || c[a] >= n) break;
+    if (c[a] < 0 || c[a] >= v.n[a]) break;
     next[a] += delta[a];
   }
   return steps;
+}
+
+/// march_level over the cells of `level` of `g` (see clip_to_grid for [t0, t1]).
+template <class F>
+int march_cells(const CellGrid& g, int level, Vec3 o, Vec3 d, float t0, float t1, F&& f) {
+  const int n = 1 << level;
+  const GridLevelView v{
+      g.lo, g.cell_size(level), {n, n, n}, g.index.data() + g.index_offset[level]};
+  return march_level(v, o, d, t0, t1, std::forward<F>(f));
 }
 
 }  // namespace amalgam

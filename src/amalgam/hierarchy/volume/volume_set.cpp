@@ -1,5 +1,6 @@
 #include "amalgam/hierarchy/volume/volume_set.h"
 
+#include <chrono>
 #include <cmath>
 
 namespace amalgam {
@@ -15,6 +16,12 @@ VolumeSet bake_volumes(const InstancedHierarchy& h, std::size_t object_meshes,
   for (const InstancedHierarchy::InstanceData& in : h.instances)
     v.instance_scale.push_back(
         static_cast<float>(std::cbrt(std::fabs(static_cast<double>(in.to_world.det())))));
+  if (config.world) {
+    const auto start = std::chrono::steady_clock::now();
+    v.world = bake_world_cells(h, v.grids, v.instance_scale, config);
+    v.world_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
   return v;
 }
 
