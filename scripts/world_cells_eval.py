@@ -22,7 +22,6 @@ Needs Debian's python3-numpy.
 import argparse
 import json
 import os
-import platform
 import subprocess
 import sys
 import tempfile
@@ -34,6 +33,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 import pfm  # noqa: E402
+from volumetric_eval import machine  # noqa: E402
 
 LUM = np.array([0.2126, 0.7152, 0.0722])
 SEEDS = (1, 2, 3)
@@ -156,8 +156,7 @@ def main():
     lines = [
         "# World cells: measured",
         "",
-        f"Written by `{cmd}` on {platform.machine()}, {os.cpu_count()} cores "
-        f"({platform.processor() or 'cpu'}); reference: full detail at {args.ref_spp} spp. "
+        f"Written by `{cmd}` ({machine()}); reference: full detail at {args.ref_spp} spp. "
         "Stratified sampling, 2 threads, seeds 1-3 (RMSE: their mean; tiles and frame: of their "
         "mean image). Tests per camera ray include the shadow tests a camera sample causes.",
         "",

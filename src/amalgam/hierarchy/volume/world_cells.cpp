@@ -287,7 +287,7 @@ WorldCells bake_world_cells(const InstancedHierarchy& h, const std::vector<CellG
 
   // Bake, then number the cells level by level and fill the dense index.
   const std::vector<LevelSums> levels = bake.bake(absorbed);
-  const std::size_t stride = static_cast<std::size_t>(w.dirs() + w.normal_bins() + 8);
+  const auto stride = static_cast<std::size_t>(Sums{w.dirs(), w.normal_bins()}.stride());
   w.index.assign(entries, 0u);
   double shine = 0.0, shine_w = 0.0;
   for (int level = 0; level < w.levels; ++level) {
