@@ -1,11 +1,14 @@
 #!/usr/bin/env python3
 """Compares two snapshot directories (scripts/dev/snapshot.sh) byte for byte, except wall-clock
-times: CSV columns named *seconds / us_per_ray are dropped, and the gnuplot inputs and plots
+times: CSV columns of times (TIMED) are dropped, and the gnuplot inputs and plots
 and report tables that carry those times are compared through their CSVs only."""
 import csv, filecmp, os, sys
 
 a, b = sys.argv[1], sys.argv[2]
-TIMED = ("seconds", "us_per_ray")
+# Columns measured in wall-clock time, or fitted to it (premise's fits of tests and kinds to
+# time, sorting's per-test times).
+TIMED = ("seconds", "us_per_ray", "us_sorted", "us_stored", "ns_per_test", "overhead_pct",
+         "time_", "fit_", "err_tests", "err_kinds")
 bad = []
 fa = sorted(os.path.relpath(os.path.join(r, f), a) for r, _, fs in os.walk(a) for f in fs)
 fb = sorted(os.path.relpath(os.path.join(r, f), b) for r, _, fs in os.walk(b) for f in fs)
