@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "amalgam/util/probe.h"
 #include "amalgam/util/version.h"
 
 namespace amalgam {
@@ -36,6 +37,7 @@ nlohmann::json stats_json(const LoadedScene& scene, const RenderOptions& o, cons
   j["tracer"] = embree ? "embree" : "amalgam";
   j["seed"] = o.seed;
   j["sampler"] = o.sampler == PixelSampler::kStratified ? "stratified" : "independent";
+  if (!light_probe().is_default()) j["light_probe"] = light_probe().describe();
   if (scene.volumes)
     j["volumes"] = {{"cells", scene.volumes->cells()},
                     {"bytes", scene.volumes->bytes()},

@@ -11,6 +11,7 @@
 #include "amalgam/scene/coordinate_limit.h"
 #include "amalgam/scene/framing.h"
 #include "amalgam/util/file_kind.h"
+#include "amalgam/util/probe.h"
 
 namespace amalgam {
 
@@ -95,8 +96,9 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   if (config.objects) {
     if (config.on_phase) config.on_phase("baking the volumetric amalgams of " + path);
     const auto* ih = std::get_if<InstancedHierarchy>(&s.hierarchy);
-    if (ih)
-      s.volumes = std::make_shared<const VolumeSet>(bake_volumes(*ih, objects, config.volume));
+    VolumeConfig volume = config.volume;
+    if (light_probe().lines > 0) volume.lines = light_probe().lines;
+    if (ih) s.volumes = std::make_shared<const VolumeSet>(bake_volumes(*ih, objects, volume));
     s.volume_seconds = std::chrono::duration<double>(Clock::now() - t2).count();
   }
   s.cameras = std::move(cameras);

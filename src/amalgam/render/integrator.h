@@ -16,6 +16,7 @@
 #include "amalgam/render/lights.h"
 #include "amalgam/render/shading.h"
 #include "amalgam/traverse/traverse.h"
+#include "amalgam/util/probe.h"
 
 namespace amalgam {
 AMALGAM_ISA_BEGIN
@@ -348,7 +349,8 @@ class Integrator {
         shadow.cone_spread = (ls.end_width - shadow.cone_width) / std::max(dist, 1e-30f);
       else
         shadow.cone_spread = ls.spread;
-      tr = trav_.transmittance(shadow, hash_combine(key, stream++));
+      const std::uint64_t shadow_key = hash_combine(key, stream++);
+      if (shadows_) tr = trav_.transmittance(shadow, shadow_key);
     }
     if (tr <= 0.0f) return {};
     return (cloud ? cloud_response(surf, wi, wo) : brdf(surf, n, wi, wo)) * ls.e * (f_cos * tr);
@@ -357,6 +359,8 @@ class Integrator {
   const H& h_;
   const Environment& env_;
   Tracer trav_;
+  /// false under the light probe's no-shadows (util/probe.h): every shadow ray passes.
+  bool shadows_ = light_probe().shadows;
   std::vector<TranslucentHit> translucent_;
   /// A member of a composite (OneMemberShadowed): its weight, unshadowed radiance, and index in
   /// translucent_ (-1: the hit).

@@ -30,6 +30,7 @@
 #include "amalgam/render/cell_shading.h"
 #include "amalgam/render/integrator.h"
 #include "amalgam/traverse/object_lod.h"
+#include "amalgam/util/probe.h"
 
 namespace amalgam {
 AMALGAM_ISA_BEGIN
@@ -53,6 +54,7 @@ class VolumeIntegrator final : private DeferSink {
   SampleResult li(const Ray& primary, std::uint64_t key) {
     ObjectLod& lod = trav_.lod();
     lod.self = 0, lod.self_full = false, lod.defer_inside = false;
+    lod.cells = probe_.camera_cells;
     objects_.clear();
     segs_.clear();
     const std::uint64_t walk_key = hash_combine(key, 0);
@@ -184,6 +186,7 @@ class VolumeIntegrator final : private DeferSink {
     Counters& counters = trav_.counters();
     if (shadow) {
       if (ob.slot == query_.self && ob.g->oriented) return;  // in its cells' shading
+      if (!(ob.slot == query_.self ? probe_.self_cells : probe_.other_cells)) return;
       transmittance *= shadow_march(ob, ray, t0, t1, counters, level);
       if (!(transmittance > kOpaque)) transmittance = 0.0f, done = true;
       return;
@@ -254,7 +257,7 @@ class VolumeIntegrator final : private DeferSink {
   /// blend; lowers the ray's tmax to where they alone saturate it.
   void world_camera(Ray& ray, std::uint64_t walk_key) {
     const WorldCells& w = v_.world;
-    if (w.empty()) return;
+    if (w.empty() || !probe_.camera_cells) return;
     const OctahedralLerp lerp = OctahedralLerp::of(ray.dir, w.dir_res);
     Counters& counters = trav_.counters();
     float left = 1.0f;
@@ -283,15 +286,17 @@ class VolumeIntegrator final : private DeferSink {
   /// grain) (docs/volumetric.md, "World cells").
   float world_shadow(const Ray& ray, std::uint64_t key) {
     const WorldCells& w = v_.world;
-    if (w.empty()) return 1.0f;
+    if (w.empty() || !probe_.world_cells || !probe_.shadow_cells) return 1.0f;
     const OctahedralLerp lerp = OctahedralLerp::of(ray.dir, w.dir_res);
     Counters& counters = trav_.counters();
     float tr = 1.0f;
     march_world(
         w, ray, ray.tmin, ray.tmax, trav_.lod().cell_pixels, world_level_u(key),
         [&](std::uint32_t cell, float a, float b, int) {
-          const float beside = std::min(
-              1.0f, 0.5f * (a + b) * query_.sin_apart / std::max(2.0f * w.grain[cell], 1e-30f));
+          const float beside = !probe_.hot_spot
+                                   ? 1.0f
+                                   : std::min(1.0f, 0.5f * (a + b) * query_.sin_apart /
+                                                        std::max(2.0f * w.grain[cell], 1e-30f));
           tr *= std::exp(-w.sigma_of(cell, lerp) * (b - a) * beside);
           return tr > kOpaque;
         },
@@ -314,14 +319,17 @@ class VolumeIntegrator final : private DeferSink {
     const OctahedralLerp lerp = ob.g->lerp(-ob.dir);
     const Vec3 cs = ob.g->cell_size(ob.level);
     const float chord = cs.x * cs.y * cs.z / ob.g->projected_area(ob.level, ob.dir);
-    const float width = std::max(ray.cone_width, 1e-30f);
+    const float width = probe_.cone_hot_spot
+                            ? std::max(ray.cone_width, 1e-30f)
+                            : std::max(2.0f * ob.g->grain * v_.instance_scale[ob.slot - 1], 1e-30f);
     const float apart_per_t = query_.sin_apart * length(ray.dir) / width;
     float tr = 1.0f;
     const int steps = march_cells(
         *ob.g, ob.level, ob.ray.origin, ob.ray.dir, t0, t1,
         [&](std::uint32_t cell, float a, float b) {
           const float pass = 1.0f - ob.g->coverage_of(cell, lerp);
-          const float beside = std::min(1.0f, 0.5f * (a + b) * apart_per_t);
+          const float beside =
+              probe_.hot_spot ? std::min(1.0f, 0.5f * (a + b) * apart_per_t) : 1.0f;
           const float share = starts_inside && a == t0 ? std::min(1.0f, (b - a) / chord) : 1.0f;
           tr *= std::pow(pass, beside * share);
           return tr > kOpaque;
@@ -453,9 +461,14 @@ class VolumeIntegrator final : private DeferSink {
     query_.sin_apart = std::sqrt(std::max(0.0f, 1.0f - cos_apart * cos_apart));
     ObjectLod& lod = trav_.lod();
     lod.self = query_.self, lod.self_full = query_.self_full, lod.defer_inside = true;
-    float tr = world_shadow(shadow, key);
-    if (tr > 0.0f) tr *= trav_.transmittance(shadow, key);
+    lod.cells = probe_.shadow_cells;
+    float tr = 1.0f;
+    if (probe_.shadows) {
+      tr = world_shadow(shadow, key);
+      if (tr > 0.0f) tr *= trav_.transmittance(shadow, key);
+    }
     lod.self = 0, lod.self_full = false, lod.defer_inside = false;
+    lod.cells = true;
     if (tr > 0.0f) colour += c.u * (c.w * tr / p);
   }
 
@@ -471,6 +484,7 @@ class VolumeIntegrator final : private DeferSink {
   const Environment& env_;
   Trav trav_;
   ShadowQuery query_;
+  LightProbe probe_ = light_probe();  ///< measurement switches (util/probe.h)
   std::vector<Object> objects_;
   std::vector<Segment> segs_;
   std::vector<Member> members_;

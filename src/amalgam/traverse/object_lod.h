@@ -32,6 +32,9 @@ struct ObjectLod {
   /// Whether an instance whose box holds the ray's origin may be deferred (shadow queries:
   /// the cells between the origin and the light count); camera rays trace it at full detail.
   bool defer_inside = false;
+  /// Whether this query reads cells at all (world cells included): false under the light
+  /// probe's camera-triangles (camera rays) or shadow-triangles (shadow rays), util/probe.h.
+  bool cells = true;
 
   /// Every node may be an instance root, so every node tested counts as an amalgam (as under
   /// ScaleSensitiveLod by footprint).
@@ -63,6 +66,7 @@ struct ObjectLod {
   /// (and passed by the sink).
   bool render_node(NodeId id, const Bbox&, int, const Ray& r, float t, bool inside,
                    std::uint64_t key) const {
+    if (!cells) return false;
     const std::uint64_t slot = InstancedHierarchy::slot(id);
     const bool root = slot != 0 && InstancedHierarchy::local(id) == 0;
     if (root && slot == self) return !self_full;
