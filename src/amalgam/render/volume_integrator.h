@@ -57,6 +57,8 @@ class VolumeIntegrator final : private DeferSink {
     lod.cells = probe_.camera_cells;
     objects_.clear();
     segs_.clear();
+    prefix_.assign(1, 1.0f);
+    scanned_ = 0;
     const std::uint64_t walk_key = hash_combine(key, 0);
     Ray camera = primary;
     world_camera(camera, walk_key);
@@ -67,15 +69,17 @@ class VolumeIntegrator final : private DeferSink {
     // where its surfaces are seen: within its segment, at the mean depth of a hit when the
     // cells overlapping there (of every object) are taken as one homogeneous medium.
     members_.clear();
+    rates_.resize(segs_.size());
     float through = 1.0f;  // what is left
     for (std::size_t k = 0; k < segs_.size() && segs_[k].t0 < t_end; ++k) {
       Segment& s = segs_[k];
       s.t1 = std::min(s.t1, t_end);
+      // Its extinction per unit t as a homogeneous segment, once (its t1 is final now).
+      rates_[k] = s.t1 > s.t0 ? -std::log(std::max(1.0f - s.alpha, 1e-6f)) / (s.t1 - s.t0) : 0.0f;
       float sigma = 0.0f;  // extinction per unit t of the segments over s.t0
       for (std::size_t q = k + 1; q-- > 0 && k - q <= 64;) {
         const Segment& o = segs_[q];
-        if (o.t1 > s.t0 && o.t1 > o.t0)
-          sigma += -std::log(std::max(1.0f - o.alpha, 1e-6f)) / (o.t1 - o.t0);
+        if (o.t1 > s.t0 && o.t1 > o.t0) sigma += rates_[q];
       }
       const float len = s.t1 - s.t0, x = sigma * len;
       // The mean of an exponential of rate sigma truncated to [0, len].
@@ -207,20 +211,46 @@ class VolumeIntegrator final : private DeferSink {
                          static_cast<std::uint64_t>(steps));
     // Merge the new cells (in depth order already) into the sorted blend, then find where it
     // saturates: nothing beyond can show, whatever the walk still finds.
-    const auto by_depth = [](const Segment& a, const Segment& b) {
-      return a.t0 < b.t0 ||
-             (a.t0 == b.t0 && (a.obj < b.obj || (a.obj == b.obj && a.cell < b.cell)));
-    };
-    std::inplace_merge(segs_.begin(), segs_.begin() + static_cast<std::ptrdiff_t>(first),
-                       segs_.end(), by_depth);
-    float through = 1.0f;
-    for (const Segment& s : segs_) {
-      through *= 1.0f - s.alpha;
+    const std::size_t from = merge_new_segments(first);
+    std::size_t k = std::min(scanned_, from);
+    float through = prefix_[k];
+    prefix_.resize(segs_.size() + 1);
+    for (; k < segs_.size(); ++k) {
+      through *= 1.0f - segs_[k].alpha;
+      prefix_[k + 1] = through;
       if (through <= kOpaque) {
-        ray.tmax = std::min(ray.tmax, s.t0);
+        ray.tmax = std::min(ray.tmax, segs_[k].t0);
         break;
       }
     }
+    scanned_ = k;
+  }
+
+  /// Depth order of the blend (ties by object and cell: the same order on any thread).
+  static bool by_depth(const Segment& a, const Segment& b) {
+    return a.t0 < b.t0 || (a.t0 == b.t0 && (a.obj < b.obj || (a.obj == b.obj && a.cell < b.cell)));
+  }
+
+  /// Merges segs_[first..) (sorted) into the sorted segs_[0..first), stably (an older segment
+  /// before an equal new one), from the back: only what lies behind the first new segment
+  /// moves. Returns the first index whose segment changed.
+  std::size_t merge_new_segments(std::size_t first) {
+    if (first == 0 || first == segs_.size()) return first;
+    const auto begin = segs_.begin();
+    const auto lo =
+        static_cast<std::size_t>(std::upper_bound(begin, begin + static_cast<std::ptrdiff_t>(first),
+                                                  segs_[first], by_depth) -
+                                 begin);
+    if (lo == first) return first;  // every new segment lies behind the old ones
+    fresh_.assign(begin + static_cast<std::ptrdiff_t>(first), segs_.end());
+    std::size_t out = segs_.size(), i = first, j = fresh_.size();
+    while (j > 0) {
+      if (i > lo && by_depth(fresh_[j - 1], segs_[i - 1]))
+        segs_[--out] = segs_[--i];
+      else
+        segs_[--out] = fresh_[--j];
+    }
+    return lo;
   }
 
   /// The members' share of the albedo and normal outputs, and the hit output: the nearest
@@ -487,6 +517,12 @@ class VolumeIntegrator final : private DeferSink {
   LightProbe probe_ = light_probe();  ///< measurement switches (util/probe.h)
   std::vector<Object> objects_;
   std::vector<Segment> segs_;
+  /// prefix_[k]: the product of 1 - alpha over segs_[0..k) in depth order, valid for k <=
+  /// scanned_ (the saturation search resumes there, or where a merge changed the blend).
+  std::vector<float> prefix_;
+  std::size_t scanned_ = 0;
+  std::vector<Segment> fresh_;  ///< merge_new_segments' copy of the new segments
+  std::vector<float> rates_;    ///< per segment: its extinction per unit t (li)
   std::vector<Member> members_;
   std::vector<Lit> lits_;
 };
