@@ -115,6 +115,7 @@ void prepare(CommonOptions& common, const RenderExtras& extra, const std::string
   budget.import_max_bytes = limit;
   budget.import_limit_name = "--max-memory " + format_bytes(static_cast<double>(limit));
   budget.objects = o.renderer() == RendererKind::kVolumetric;
+  budget.amalgams = o.renderer() == RendererKind::kScaleSensitive;  // no unused bake
   budget.smooth_normals = common.smooth_normals;
   budget.on_phase = [&](const std::string& what) {
     set_activity(what);
@@ -389,6 +390,7 @@ int run_trace(CommonOptions& common, const std::string& origin, const std::strin
   set_activity("loading and building " + common.scene);
   SceneFileConfig config;
   config.objects = common.options.renderer() == RendererKind::kVolumetric;
+  config.amalgams = common.options.renderer() == RendererKind::kScaleSensitive;
   config.smooth_normals = common.smooth_normals;
   LoadedScene scene = load_scene(common.scene, common.params(), config);
   common.prepare(scene);

@@ -9,6 +9,7 @@
 #include "amalgam/hierarchy/flatten.h"
 #include "amalgam/hierarchy/wide.h"
 #include "amalgam/load/load_scene.h"
+#include "amalgam/util/error.h"
 
 namespace amalgam {
 namespace {
@@ -175,6 +176,28 @@ TEST(Render, ExplicitFlattenMatchesImplicit) {
     EXPECT_EQ(a.counters.by_level, b.counters.by_level);
     EXPECT_EQ(a.colour, b.colour);
   }
+}
+
+// The full-detail renderers never render a box amalgam: a scene loaded without the amalgams'
+// appearances (SceneFileConfig::amalgams, what the CLI does for them) renders the same bytes
+// and counts, and the scale-sensitive renderer refuses it.
+TEST(Render, FullDetailNeedsNoAmalgamBake) {
+  const std::string path = AMALGAM_SOURCE_DIR "/scenes/volumetric/wuson.json";
+  const LoadedScene baked = load_scene(path, Params(path));
+  SceneFileConfig bare_config;
+  bare_config.amalgams = false;
+  const LoadedScene bare = load_scene(path, Params(path), bare_config);
+  EXPECT_TRUE(baked.amalgams);
+  EXPECT_FALSE(bare.amalgams);
+  RenderOptions o = small(40, 30, 2);
+  o.lod = FullDetail{};
+  const RenderOutput a = render(baked, o), b = render(bare, o);
+  EXPECT_EQ(a.image, b.image);
+  EXPECT_EQ(a.counters.total(), b.counters.total());
+  EXPECT_EQ(a.counters.by_level, b.counters.by_level);
+  o.lod = ByFootprint{1.0f};
+  EXPECT_NO_THROW(render(baked, o));
+  EXPECT_THROW(render(bare, o), InternalError);
 }
 
 }  // namespace

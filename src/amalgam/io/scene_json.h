@@ -32,6 +32,9 @@ struct SceneFileConfig {
   bool objects = false;
   /// The cells baked for each object when `objects` is set (load/load_scene.h).
   VolumeConfig volume{};
+  /// Bake the box amalgams' appearances (BakeConfig::appearances): only the scale-sensitive
+  /// renderer renders them; false builds the hierarchy without (LoadedScene::amalgams).
+  bool amalgams = true;
   /// Bytes the built scene may take (0: no limit), checked before any triangle is expanded or
   /// built, with MemoryModel (hierarchy/build/build.h); `limit_name` names the limit in the
   /// message (e.g. "--max-memory 100 MiB less the film").

@@ -89,6 +89,7 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   double bake_seconds = 0.0;
   BuildConfig build;
   build.bake_seconds = &bake_seconds;
+  build.bake.appearances = config.amalgams;
   const std::size_t objects = d.meshes.size();  // the loose primitives come after them
   AnyHierarchy h = build_hierarchy(std::move(d), build);
   const auto t2 = Clock::now();
@@ -108,6 +109,7 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   s.framed_camera = framed;
   s.load_seconds = std::chrono::duration<double>(t1 - t0).count();
   s.bake_seconds = bake_seconds;
+  s.amalgams = config.amalgams;
   s.build_seconds = std::max(0.0, std::chrono::duration<double>(t2 - t1).count() - bake_seconds);
   return s;
 }

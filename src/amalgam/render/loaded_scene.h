@@ -28,6 +28,9 @@ struct LoadedScene {
   double load_seconds = 0.0;   ///< reading the scene (or making a builtin's)
   double build_seconds = 0.0;  ///< building the hierarchy, the bake not included
   double bake_seconds = 0.0;   ///< baking the amalgams' appearances
+  /// Whether the amalgams have their appearances (false: loaded with SceneFileConfig::amalgams
+  /// off, for a renderer that renders none; the scale-sensitive renderer refuses it).
+  bool amalgams = true;
   /// The volumetric amalgams of the scene's objects (a scene loaded with
   /// SceneFileConfig::objects: instanced hierarchy, every mesh an instance), else null.
   std::shared_ptr<const VolumeSet> volumes{};

@@ -8,6 +8,7 @@
 
 #include "amalgam/render/option_rules.h"
 #include "amalgam/render/render_isa.h"
+#include "amalgam/util/check.h"
 #include "amalgam/util/isa.h"
 
 namespace amalgam {
@@ -26,6 +27,8 @@ void check_options(const LoadedScene& scene, const RenderOptions& o, OptionSpell
   if (o.width < 1 || o.height < 1 || o.spp < 1)
     throw InputError(option_text("--width", spelling) + ", " + option_text("--height", spelling) +
                      " and " + option_text("--spp", spelling) + " must be at least 1");
+  AMALGAM_CHECK(scene.amalgams || o.renderer() != RendererKind::kScaleSensitive,
+                "the scale-sensitive renderer on a scene loaded without its amalgams' appearances");
   if (o.tracer == TracerKind::kEmbree && o.renderer() != RendererKind::kTraditional)
     throw InputError(option_text("--tracer", spelling, "embree") +
                      " renders at full detail: only " +

@@ -372,7 +372,12 @@ void bake_appearances(ExplicitHierarchy& h, const BakeConfig& config) {
 }  // namespace
 
 void bake(ExplicitHierarchy& h, const BakeConfig& config) {
-  bake_appearances(h, config);
+  if (config.appearances) {
+    bake_appearances(h, config);
+  } else {
+    h.appearances.assign(h.nodes.size(), Appearance{});
+    h.root_normals = NormalTensor{};
+  }
   // After the bake's per-node temporaries are freed: the packing briefly holds the whole
   // primitives, the packs and the slots at once (the build's peak).
   build_wide(h);
@@ -380,6 +385,7 @@ void bake(ExplicitHierarchy& h, const BakeConfig& config) {
 
 void bake(InstancedHierarchy& h, const BakeConfig& config) {
   h.top_appearances.assign(h.top_nodes.size(), Appearance{});
+  if (!config.appearances) return;
   std::vector<NormalTensor> tensors(h.top_nodes.size());
   const BakeConfig& bc = config;
   auto bake_one = [&](std::size_t i) {

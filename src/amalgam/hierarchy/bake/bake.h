@@ -30,15 +30,19 @@ struct BakeConfig {
   /// form closed, consistently wound surfaces (closed_orientation); the check is skipped for
   /// more triangles than this (it sorts two 8-byte keys per edge).
   std::uint64_t orient_max_triangles = std::uint64_t{1} << 24;
+  /// false: the amalgams get no appearance (every one the default Appearance, no root normals):
+  /// for renderers that never render a box amalgam (traditional, volumetric, Embree), which
+  /// then pay only for the SIMD form.
+  bool appearances = true;
 };
 
 /// Bakes every node of `h` bottom-up, one level at a time. A node with at most
 /// `config.exact_prims` primitives below it is baked exactly: `config.rays` random lines
 /// through its box are traced against its subtree; opacity = fraction that hit, colour = mean
 /// colour of the surfaces hit (a textured triangle: its colour times its texture's mean over
-/// the triangle's texture coordinates), normal = dominant axis of their normals. A larger node combines
-/// its children (`bake_from_children`). Sets `h.appearances`, `h.root_normals` and rebuilds the
-/// SIMD child boxes (`build_wide`).
+/// the triangle's texture coordinates), normal = dominant axis of their normals. A larger node
+/// combines its children (`bake_from_children`). Sets `h.appearances`, `h.root_normals` and
+/// rebuilds the SIMD child boxes (`build_wide`).
 void bake(ExplicitHierarchy& h, const BakeConfig& config = {});
 
 /// Bakes the top level of an instanced hierarchy bottom-up from its instance roots, whose
