@@ -27,6 +27,7 @@
 #include <numbers>
 #include <vector>
 
+#include "amalgam/render/cell_blend.h"
 #include "amalgam/render/cell_shading.h"
 #include "amalgam/render/integrator.h"
 #include "amalgam/traverse/object_lod.h"
@@ -56,9 +57,7 @@ class VolumeIntegrator final : private DeferSink {
     lod.self = 0, lod.self_full = false, lod.defer_inside = false;
     lod.cells = probe_.camera_cells;
     objects_.clear();
-    segs_.clear();
-    prefix_.assign(1, 1.0f);
-    scanned_ = 0;
+    blend_.clear();
     const std::uint64_t walk_key = hash_combine(key, 0);
     Ray camera = primary;
     world_camera(camera, walk_key);
@@ -69,16 +68,16 @@ class VolumeIntegrator final : private DeferSink {
     // where its surfaces are seen: within its segment, at the mean depth of a hit when the
     // cells overlapping there (of every object) are taken as one homogeneous medium.
     members_.clear();
-    rates_.resize(segs_.size());
+    rates_.resize(blend_.items.size());
     float through = 1.0f;  // what is left
-    for (std::size_t k = 0; k < segs_.size() && segs_[k].t0 < t_end; ++k) {
-      Segment& s = segs_[k];
+    for (std::size_t k = 0; k < blend_.items.size() && blend_.items[k].t0 < t_end; ++k) {
+      Segment& s = blend_.items[k];
       s.t1 = std::min(s.t1, t_end);
       // Its extinction per unit t as a homogeneous segment, once (its t1 is final now).
       rates_[k] = s.t1 > s.t0 ? -std::log(std::max(1.0f - s.alpha, 1e-6f)) / (s.t1 - s.t0) : 0.0f;
       float sigma = 0.0f;  // extinction per unit t of the segments over s.t0
       for (std::size_t q = k + 1; q-- > 0 && k - q <= 64;) {
-        const Segment& o = segs_[q];
+        const Segment& o = blend_.items[q];
         if (o.t1 > s.t0 && o.t1 > o.t0) sigma += rates_[q];
       }
       const float len = s.t1 - s.t0, x = sigma * len;
@@ -138,12 +137,8 @@ class VolumeIntegrator final : private DeferSink {
     Ray ray;         ///< the ray in object space (direction unnormalised: the same t)
     Vec3 dir;        ///< the ray's unit direction in object space
   };
-  struct Segment {
-    float t0, t1;
-    std::uint32_t cell;
-    std::uint32_t obj;  ///< index in objects_, or kWorld + level: a world cell
-    float alpha;
-  };
+  /// CellSegment::obj: an index in objects_, or kWorld + level: a world cell.
+  using Segment = CellSegment;
   struct Member {
     float w;
     int seg;
@@ -198,12 +193,13 @@ class VolumeIntegrator final : private DeferSink {
     const auto index = static_cast<std::uint32_t>(objects_.size());
     objects_.push_back(ob);
     const OctahedralLerp lerp = ob.g->lerp(ob.dir);
-    const std::size_t first = segs_.size();
+    const std::size_t first = blend_.items.size();
     float left = 1.0f;  // this object's own transmittance so far
     const int steps = march_cells(*ob.g, ob.level, ob.ray.origin, ob.ray.dir, t0, t1,
                                   [&](std::uint32_t cell, float a, float b) {
                                     const float alpha = ob.g->coverage_of(cell, lerp);
-                                    if (alpha > 0.0f) segs_.push_back({a, b, cell, index, alpha});
+                                    if (alpha > 0.0f)
+                                      blend_.items.push_back({a, b, cell, index, alpha});
                                     left *= 1.0f - alpha;
                                     return left > kOpaque;
                                   });
@@ -211,46 +207,7 @@ class VolumeIntegrator final : private DeferSink {
                          static_cast<std::uint64_t>(steps));
     // Merge the new cells (in depth order already) into the sorted blend, then find where it
     // saturates: nothing beyond can show, whatever the walk still finds.
-    const std::size_t from = merge_new_segments(first);
-    std::size_t k = std::min(scanned_, from);
-    float through = prefix_[k];
-    prefix_.resize(segs_.size() + 1);
-    for (; k < segs_.size(); ++k) {
-      through *= 1.0f - segs_[k].alpha;
-      prefix_[k + 1] = through;
-      if (through <= kOpaque) {
-        ray.tmax = std::min(ray.tmax, segs_[k].t0);
-        break;
-      }
-    }
-    scanned_ = k;
-  }
-
-  /// Depth order of the blend (ties by object and cell: the same order on any thread).
-  static bool by_depth(const Segment& a, const Segment& b) {
-    return a.t0 < b.t0 || (a.t0 == b.t0 && (a.obj < b.obj || (a.obj == b.obj && a.cell < b.cell)));
-  }
-
-  /// Merges segs_[first..) (sorted) into the sorted segs_[0..first), stably (an older segment
-  /// before an equal new one), from the back: only what lies behind the first new segment
-  /// moves. Returns the first index whose segment changed.
-  std::size_t merge_new_segments(std::size_t first) {
-    if (first == 0 || first == segs_.size()) return first;
-    const auto begin = segs_.begin();
-    const auto lo =
-        static_cast<std::size_t>(std::upper_bound(begin, begin + static_cast<std::ptrdiff_t>(first),
-                                                  segs_[first], by_depth) -
-                                 begin);
-    if (lo == first) return first;  // every new segment lies behind the old ones
-    fresh_.assign(begin + static_cast<std::ptrdiff_t>(first), segs_.end());
-    std::size_t out = segs_.size(), i = first, j = fresh_.size();
-    while (j > 0) {
-      if (i > lo && by_depth(fresh_[j - 1], segs_[i - 1]))
-        segs_[--out] = segs_[--i];
-      else
-        segs_[--out] = fresh_[--j];
-    }
-    return lo;
+    ray.tmax = std::min(ray.tmax, blend_.merge(first, kOpaque));
   }
 
   /// The members' share of the albedo and normal outputs, and the hit output: the nearest
@@ -258,7 +215,7 @@ class VolumeIntegrator final : private DeferSink {
   void blend_outputs(Vec3 dir, float through, SampleResult& r) const {
     float amalgam_weight = 0.0f;
     for (const Member& m : members_) {
-      const Segment& s = segs_[static_cast<std::size_t>(m.seg)];
+      const Segment& s = blend_.items[static_cast<std::size_t>(m.seg)];
       if (s.obj >= kWorld) {
         r.albedo += v_.world.surface[s.cell].albedo * m.w;
         r.normal += world_normal(s.cell, dir) * m.w;
@@ -271,7 +228,7 @@ class VolumeIntegrator final : private DeferSink {
     }
     if (!members_.empty() && amalgam_weight >= through) {
       const Member& m = members_.front();
-      const Segment& s = segs_[static_cast<std::size_t>(m.seg)];
+      const Segment& s = blend_.items[static_cast<std::size_t>(m.seg)];
       if (s.obj >= kWorld) {
         r.hit = TraceHit{TraceHit::Kind::kAmalgam, m.t, IH::id(0, 0),
                          static_cast<int>(s.obj - kWorld), SurfaceHit{}};
@@ -296,7 +253,7 @@ class VolumeIntegrator final : private DeferSink {
         [&](std::uint32_t cell, float a, float b, int level) {
           const float alpha = 1.0f - std::exp(-w.sigma_of(cell, lerp) * (b - a));
           if (alpha > 0.0f)
-            segs_.push_back({a, b, cell, kWorld + static_cast<std::uint32_t>(level), alpha});
+            blend_.items.push_back({a, b, cell, kWorld + static_cast<std::uint32_t>(level), alpha});
           left *= 1.0f - alpha;
           if (left > kOpaque) return true;
           ray.tmax = std::min(ray.tmax, a);
@@ -446,7 +403,7 @@ class VolumeIntegrator final : private DeferSink {
     lits_.clear();
     const Vec3 wo = -primary.dir;
     for (const Member& m : members_) {
-      const Segment& s = segs_[static_cast<std::size_t>(m.seg)];
+      const Segment& s = blend_.items[static_cast<std::size_t>(m.seg)];
       const Vec3 p = primary.at(m.t);
       LightSample ls;
       if (!light_sample(light, p, Vec3{}, samples, u1, u2, ls)) continue;
@@ -484,7 +441,8 @@ class VolumeIntegrator final : private DeferSink {
       shadow.cone_spread = (c.ls.end_width - shadow.cone_width) / std::max(c.ls.dist, 1e-30f);
     else
       shadow.cone_spread = c.ls.spread;
-    const std::uint32_t from_obj = from_cell ? segs_[static_cast<std::size_t>(c.seg)].obj : 0;
+    const std::uint32_t from_obj =
+        from_cell ? blend_.items[static_cast<std::size_t>(c.seg)].obj : 0;
     query_.self = !from_cell ? IH::slot(hit.id) : from_obj < kWorld ? objects_[from_obj].slot : 0;
     query_.self_full = !from_cell;
     const float cos_apart = std::clamp(dot(wo, c.ls.wi), -1.0f, 1.0f);
@@ -506,7 +464,7 @@ class VolumeIntegrator final : private DeferSink {
   float members_t(int seg) const {
     for (const Member& m : members_)
       if (m.seg == seg) return m.t;
-    return segs_[static_cast<std::size_t>(seg)].t0;
+    return blend_.items[static_cast<std::size_t>(seg)].t0;
   }
 
   const IH& h_;
@@ -516,13 +474,8 @@ class VolumeIntegrator final : private DeferSink {
   ShadowQuery query_;
   LightProbe probe_ = light_probe();  ///< measurement switches (util/probe.h)
   std::vector<Object> objects_;
-  std::vector<Segment> segs_;
-  /// prefix_[k]: the product of 1 - alpha over segs_[0..k) in depth order, valid for k <=
-  /// scanned_ (the saturation search resumes there, or where a merge changed the blend).
-  std::vector<float> prefix_;
-  std::size_t scanned_ = 0;
-  std::vector<Segment> fresh_;  ///< merge_new_segments' copy of the new segments
-  std::vector<float> rates_;    ///< per segment: its extinction per unit t (li)
+  CellBlend blend_;
+  std::vector<float> rates_;  ///< per segment: its extinction per unit t (li)
   std::vector<Member> members_;
   std::vector<Lit> lits_;
 };
