@@ -50,6 +50,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 import pfm  # noqa: E402
+from volumetric_eval import binary_hash, machine  # noqa: E402
 
 LUM = np.array([0.2126, 0.7152, 0.0722])
 SKY = [0.35, 0.45, 0.65]
@@ -122,16 +123,6 @@ LIGHTS = {"tree-400": ["scene", "sun", "sky-1", "sky-2", "sky-16"], "forest": [x
 
 def lum(img):
     return img @ LUM
-
-
-_HASHES = {}
-
-
-def binary_hash(path):
-    if path not in _HASHES:
-        with open(path, "rb") as f:
-            _HASHES[path] = hashlib.sha1(f.read()).hexdigest()
-    return _HASHES[path]
 
 
 def load_scene(path):
@@ -271,18 +262,6 @@ def measure(a, r, name):
 
 def fmt(x):
     return "" if x is None else f"{100 * x:+.2f} %"
-
-
-def machine():
-    cpu = "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            cpu = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
-                            capture_output=True, text=True).stdout.strip()
-    return f"{cpu}, {os.cpu_count()} cores, {time.strftime('%Y-%m-%d')}, commit {commit}"
 
 
 HEADER = ("| view | lights | term | error (object or frame) | se | frame | worst tile | "

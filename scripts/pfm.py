@@ -15,3 +15,11 @@ def read_pfm(path):
         channels = 3 if kind == b"PF" else 1
         data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
     return data.reshape(height, width, channels)[::-1]
+
+
+def write_pfm(path, img):
+    """Writes an H x W x 3 array (top row first) as a little-endian colour PFM."""
+    h, w, _ = img.shape
+    with open(path, "wb") as f:
+        f.write(b"PF\n%d %d\n-1.0\n" % (w, h))
+        f.write(np.ascontiguousarray(img[::-1], dtype="<f4").tobytes())

@@ -63,6 +63,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 from exr_layers import read_exr  # noqa: E402
+import pfm  # noqa: E402
 
 SOIL = (0.3, 0.22, 0.15)  # the ground of all three scenes
 # name: scene, the full frame (W, H), the window (w, h) or None for the whole frame, the row of
@@ -163,13 +164,6 @@ def instances_in_frame(scene_path, full, height=5.0):
     return total, inside
 
 
-def write_pfm(path, img):
-    h, w, _ = img.shape
-    with open(path, "wb") as f:
-        f.write(b"PF\n%d %d\n-1.0\n" % (w, h))
-        f.write(np.ascontiguousarray(img[::-1], dtype="<f4").tobytes())
-
-
 def run(cmd):
     print("+", " ".join(cmd), file=sys.stderr, flush=True)
     t0 = time.monotonic()
@@ -242,13 +236,11 @@ def measure(name, a):
         layers = read_exr(hi)
         rgb = np.stack([layers["R"], layers["G"], layers["B"]], axis=-1)
         hi_pfm = os.path.join(tmp, "hi.pfm")
-        write_pfm(hi_pfm, rgb)
+        pfm.write_pfm(hi_pfm, rgb)
         ref = rgb.astype(np.float64).reshape(h, f, w, f, 3).mean(axis=(1, 3))
         res["shares"] = shares(layers, f, ground)
         del layers, rgb
         # Full detail at the view's pixels, 16 stratified samples, two other seeds.
-        import pfm  # noqa: E402
-
         fd, res["target_seconds"] = [], 0.0
         for seed in (12, 13):
             lo = os.path.join(tmp, f"fd16-{seed}.pfm")
