@@ -182,11 +182,10 @@ class VolumeIntegrator final : private DeferSink {
     Object ob = object_of(root, level, t, ray, key);
     float t0 = ray.tmin, t1 = ray.tmax;
     if (!clip_to_grid(*ob.g, ob.ray.origin, ob.ray.dir, t0, t1)) return;
-    Counters& counters = trav_.counters();
     if (shadow) {
       if (ob.slot == query_.self && ob.g->oriented) return;  // in its cells' shading
       if (!(ob.slot == query_.self ? probe_.self_cells : probe_.other_cells)) return;
-      transmittance *= shadow_march(ob, ray, t0, t1, counters, level);
+      transmittance *= shadow_march(ob, ray, t0, t1, level);
       if (!(transmittance > kOpaque)) transmittance = 0.0f, done = true;
       return;
     }
@@ -203,8 +202,7 @@ class VolumeIntegrator final : private DeferSink {
                                     left *= 1.0f - alpha;
                                     return left > kOpaque;
                                   });
-    counters.count_tests(RayKind::kPrimary, ObjectKind::kCell, level + 1 + ob.level,
-                         static_cast<std::uint64_t>(steps));
+    trav_.count_cells(RayKind::kPrimary, level + 1 + ob.level, static_cast<std::uint64_t>(steps));
     // Merge the new cells (in depth order already) into the sorted blend, then find where it
     // saturates: nothing beyond can show, whatever the walk still finds.
     ray.tmax = std::min(ray.tmax, blend_.merge(first, kOpaque));
@@ -246,7 +244,6 @@ class VolumeIntegrator final : private DeferSink {
     const WorldCells& w = v_.world;
     if (w.empty() || !probe_.camera_cells) return;
     const OctahedralLerp lerp = OctahedralLerp::of(ray.dir, w.dir_res);
-    Counters& counters = trav_.counters();
     float left = 1.0f;
     march_world(
         w, ray, ray.tmin, ray.tmax, trav_.lod().cell_pixels, world_level_u(walk_key),
@@ -260,8 +257,7 @@ class VolumeIntegrator final : private DeferSink {
           return false;
         },
         [&](int level, int steps) {
-          counters.count_tests(RayKind::kPrimary, ObjectKind::kCell, level,
-                               static_cast<std::uint64_t>(steps));
+          trav_.count_cells(RayKind::kPrimary, level, static_cast<std::uint64_t>(steps));
         });
   }
 
@@ -275,7 +271,6 @@ class VolumeIntegrator final : private DeferSink {
     const WorldCells& w = v_.world;
     if (w.empty() || !probe_.world_cells || !probe_.shadow_cells) return 1.0f;
     const OctahedralLerp lerp = OctahedralLerp::of(ray.dir, w.dir_res);
-    Counters& counters = trav_.counters();
     float tr = 1.0f;
     march_world(
         w, ray, ray.tmin, ray.tmax, trav_.lod().cell_pixels, world_level_u(key),
@@ -288,8 +283,7 @@ class VolumeIntegrator final : private DeferSink {
           return tr > kOpaque;
         },
         [&](int level, int steps) {
-          counters.count_tests(RayKind::kShadow, ObjectKind::kCell, level,
-                               static_cast<std::uint64_t>(steps));
+          trav_.count_cells(RayKind::kShadow, level, static_cast<std::uint64_t>(steps));
         });
     return tr > kOpaque ? tr : 0.0f;
   }
@@ -300,8 +294,7 @@ class VolumeIntegrator final : private DeferSink {
   /// ahead (as a homogeneous cell would); where the shadow ray's cone still overlaps the camera
   /// cone that reached its origin (both one cone width wide there: the hot spot), only the
   /// share of the chord beside that cone counts.
-  float shadow_march(const Object& ob, const Ray& ray, float t0, float t1, Counters& counters,
-                     int root_level) {
+  float shadow_march(const Object& ob, const Ray& ray, float t0, float t1, int root_level) {
     const bool starts_inside = t0 == ray.tmin;
     const OctahedralLerp lerp = ob.g->lerp(-ob.dir);
     const Vec3 cs = ob.g->cell_size(ob.level);
@@ -321,8 +314,8 @@ class VolumeIntegrator final : private DeferSink {
           tr *= std::pow(pass, beside * share);
           return tr > kOpaque;
         });
-    counters.count_tests(RayKind::kShadow, ObjectKind::kCell, root_level + 1 + ob.level,
-                         static_cast<std::uint64_t>(steps));
+    trav_.count_cells(RayKind::kShadow, root_level + 1 + ob.level,
+                      static_cast<std::uint64_t>(steps));
     return tr;
   }
 

@@ -100,6 +100,11 @@ struct RayState {
   void count_children(int level, int n) {
     counters.count_tests(kind, object_kind(level), level, static_cast<std::uint64_t>(n));
   }
+  /// `n` cells of volumetric amalgams on `level`, stepped through by a ray of kind `k` (a
+  /// camera or shadow march of render/volume_integrator.h, which runs beside the walk).
+  void count_cells(RayKind k, int level, std::uint64_t n) {
+    counters.count_tests(k, ObjectKind::kCell, level, n);
+  }
   /// `n` primitives tested on `level`.
   void count_primitives(int level, int n = 1) {
     counters.count_tests(kind, ObjectKind::kPrimitive, level, static_cast<std::uint64_t>(n));

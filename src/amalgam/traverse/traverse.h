@@ -75,7 +75,9 @@ class Traversal {
   /// The level-of-detail policy, to change between rays (ObjectLod's origin instance).
   Lod& lod() { return s_.lod; }
   Opacity& opacity() { return s_.opacity; }
-  Stats& counters() { return s_.counters; }
+  /// `n` cells of volumetric amalgams stepped through by a ray of kind `k` on `level`
+  /// (render/volume_integrator.h marches them outside the walk; counted as the walk counts).
+  void count_cells(RayKind k, int level, std::uint64_t n) { s_.count_cells(k, level, n); }
 
  private:
   static constexpr bool kSorted = Order::kSorted;
