@@ -109,13 +109,16 @@ inline float spot_falloff(const Light& l, Vec3 wi) {
 /// drawn by the map's luminance (scene/sky.h); without, a constant radiance: cosine-weighted
 /// about the normal (uniform over the sphere without one). The sample carries radiance /
 /// (density x n), so that brdf x e x cos sums to the irradiance-weighted estimate. Its cone
-/// spreads as wide as its share of the hemisphere.
+/// spreads as wide as its share of the sphere (below: a known fault for the volumetric renderer).
 inline bool sample_sky(const Light& l, const SkyMap* map, Vec3 normal, float u1, float u2, int n,
                        LightSample& s) {
   constexpr float pi = std::numbers::pi_v<float>;
   const float share = 1.0f / static_cast<float>(std::max(n, 1));
   s.dist = kInfinity;
-  const float cos_half = std::max(-1.0f, 1.0f - 2.0f * share);  // a cap of 2 pi / n sr
+  // A cap of 4 pi / n sr, the sample's share of the whole sphere. Its spread 2 tan(half-angle)
+  // is 0 at n = 1 (the cap is the sphere) and about 2000 at n = 2 (a hemisphere), so the mean
+  // of a shadow read through cells depends on n (docs/volumetric/bias-terms.md, sky-n rows).
+  const float cos_half = std::max(-1.0f, 1.0f - 2.0f * share);
   s.spread =
       2.0f * std::sqrt(std::max(0.0f, 1.0f - cos_half * cos_half)) / std::max(cos_half, 1e-3f);
   if (map != nullptr) {
