@@ -39,6 +39,14 @@ namespace amalgam::cli {
 
 namespace {
 
+/// What the scene is loaded with for `common`'s renderer: cells for the volumetric renderer,
+/// the box amalgams' appearances only for the scale-sensitive one (the rest never render them).
+void load_for_renderer(SceneFileConfig& config, const CommonOptions& common) {
+  config.objects = common.options.renderer() == RendererKind::kVolumetric;
+  config.amalgams = common.options.renderer() == RendererKind::kScaleSensitive;
+  config.smooth_normals = common.smooth_normals;
+}
+
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
 std::atomic<int> g_signals{0};  ///< stop signals received
@@ -114,9 +122,7 @@ void prepare(CommonOptions& common, const RenderExtras& extra, const std::string
                       format_bytes(static_cast<double>(film)) + " for the film";
   budget.import_max_bytes = limit;
   budget.import_limit_name = "--max-memory " + format_bytes(static_cast<double>(limit));
-  budget.objects = o.renderer() == RendererKind::kVolumetric;
-  budget.amalgams = o.renderer() == RendererKind::kScaleSensitive;  // no unused bake
-  budget.smooth_normals = common.smooth_normals;
+  load_for_renderer(budget, common);
   budget.on_phase = [&](const std::string& what) {
     set_activity(what);
     status.phase(what);
@@ -389,9 +395,7 @@ int run_trace(CommonOptions& common, const std::string& origin, const std::strin
   common.finish();
   set_activity("loading and building " + common.scene);
   SceneFileConfig config;
-  config.objects = common.options.renderer() == RendererKind::kVolumetric;
-  config.amalgams = common.options.renderer() == RendererKind::kScaleSensitive;
-  config.smooth_normals = common.smooth_normals;
+  load_for_renderer(config, common);
   LoadedScene scene = load_scene(common.scene, common.params(), config);
   common.prepare(scene);
   print_warnings(scene);
