@@ -11,7 +11,8 @@
 /// - disc of angular diameter a about -direction (a sun): weight E / n.
 /// Each shadow ray answers for 1/n of the light's solid angle, so its cone widens from the
 /// pixel's footprint to the light's width / sqrt(n) at the light: the shadow rays of a soft
-/// shadow see occluders as coarse as the penumbra they blur.
+/// shadow see occluders as coarse as the penumbra they blur. The sky has no such width: its
+/// shadow rays keep the footprint's (sample_sky).
 
 #include <algorithm>
 #include <cmath>
@@ -108,19 +109,17 @@ inline float spot_falloff(const Light& l, Vec3 wi) {
 /// shading normal `normal` (or the zero vector: no preferred side). With a map: a direction
 /// drawn by the map's luminance (scene/sky.h); without, a constant radiance: cosine-weighted
 /// about the normal (uniform over the sphere without one). The sample carries radiance /
-/// (density x n), so that brdf x e x cos sums to the irradiance-weighted estimate. Its cone
-/// spreads as wide as its share of the sphere (below: a known fault for the volumetric renderer).
+/// (density x n), so that brdf x e x cos sums to the irradiance-weighted estimate. Its shadow
+/// ray is a parallel beam of the footprint's width (spread 0), whatever n: a cone as wide as the
+/// sample's share of the sky would read occluders at a level set by the sample count (a
+/// hemisphere at n = 2 reads the coarsest cells), and cells read at different levels do not
+/// have the same mean transmittance, so the image's mean would depend on n.
 inline bool sample_sky(const Light& l, const SkyMap* map, Vec3 normal, float u1, float u2, int n,
                        LightSample& s) {
   constexpr float pi = std::numbers::pi_v<float>;
   const float share = 1.0f / static_cast<float>(std::max(n, 1));
   s.dist = kInfinity;
-  // A cap of 4 pi / n sr, the sample's share of the whole sphere. Its spread 2 tan(half-angle)
-  // is 0 at n = 1 (the cap is the sphere) and about 2000 at n = 2 (a hemisphere), so the mean
-  // of a shadow read through cells depends on n (docs/volumetric/bias-terms.md, sky-n rows).
-  const float cos_half = std::max(-1.0f, 1.0f - 2.0f * share);
-  s.spread =
-      2.0f * std::sqrt(std::max(0.0f, 1.0f - cos_half * cos_half)) / std::max(cos_half, 1e-3f);
+  s.spread = 0.0f;
   if (map != nullptr) {
     const SkyMap::Sample m = map->sample(u1, u2);
     if (!(m.pdf > 0.0f)) return false;
