@@ -11,9 +11,11 @@ import sys
 LAYERS = ["util", "math", "geometry", "stats", "scene", "hierarchy", "builtin", "traverse",
           "render", "analysis", "io", "load"]
 # The files that compile the per-instruction-set copies (embree_tracer.cpp: the integrator and
-# pass loop over Embree, its portable copy only).
+# pass loop over Embree, its portable copy only; lit_ratio.cpp: the traversal for a bake, its
+# portable copy only).
 ISA_ENTRIES = {"amalgam/render/render_isa.inl", "amalgam/render/render_portable.cpp",
-               "amalgam/render/render_avx2.cpp", "amalgam/render/embree_tracer.cpp"}
+               "amalgam/render/render_avx2.cpp", "amalgam/render/embree_tracer.cpp",
+               "amalgam/traverse/lit_ratio.cpp"}
 
 root = os.path.join(sys.argv[1] if len(sys.argv) > 1 else os.getcwd(), "src")
 inc = re.compile(r'^\s*#\s*include\s+"(amalgam/[^"]+)"', re.M)

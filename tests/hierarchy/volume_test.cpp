@@ -10,30 +10,12 @@
 #include "amalgam/math/random.h"
 #include "amalgam/traverse/cone_march.h"
 #include "amalgam/traverse/traverse.h"
+#include "leaves.h"
 
 namespace amalgam {
 namespace {
 
 /// `n` small random quads (two triangles each) in a ball of radius 1: foliage.
-std::vector<Primitive> leaves(int n, std::uint64_t seed) {
-  std::vector<Primitive> out;
-  Sampler s(seed);
-  for (int i = 0; i < n; ++i) {
-    Vec3 c;
-    do {
-      c = {2 * s.next() - 1, 2 * s.next() - 1, 2 * s.next() - 1};
-    } while (dot(c, c) > 1.0f);
-    const float z = 2 * s.next() - 1, phi = 6.2831853f * s.next();
-    const Vec3 nrm{std::sqrt(1 - z * z) * std::cos(phi), std::sqrt(1 - z * z) * std::sin(phi), z};
-    const Vec3 a = std::fabs(nrm.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-    const Vec3 u = normalize(cross(a, nrm)) * 0.06f, v = cross(nrm, normalize(u)) * 0.04f;
-    out.push_back({PrimKind::kTriangle, 0, c - u - v, c + u - v, c + u + v});
-    out.push_back({PrimKind::kTriangle, 0, c - u - v, c + u + v, c - u + v});
-  }
-  return out;
-}
-
-/// A closed octahedron-subdivided sphere of radius r (outward wound).
 std::vector<Primitive> sphere(float r, int level) {
   std::vector<std::array<Vec3, 3>> f = {
       {Vec3{1, 0, 0}, {0, 1, 0}, {0, 0, 1}},    {Vec3{0, 1, 0}, {-1, 0, 0}, {0, 0, 1}},

@@ -41,13 +41,12 @@ double frame_luminance(LoadedScene& scene, int sky_samples) {
 TEST(SkyMean, SameForAnySampleCount) {
   SceneFileConfig c;
   c.objects = true;
-  LoadedScene scene =
-      load_scene_path(std::string(AMALGAM_SOURCE_DIR) + "/scenes/forest.json", c);
+  LoadedScene scene = load_scene_path(std::string(AMALGAM_SOURCE_DIR) + "/scenes/forest.json", c);
   const double one = frame_luminance(scene, 1);
   ASSERT_GT(one, 0.0);
   for (const int n : {2, 4}) {
     const double mean = frame_luminance(scene, n);
-        EXPECT_NEAR(mean / one, 1.0, 0.01) << n << " sky samples";
+    EXPECT_NEAR(mean / one, 1.0, 0.01) << n << " sky samples";
   }
 }
 

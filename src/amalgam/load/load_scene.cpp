@@ -10,6 +10,7 @@
 #include "amalgam/render/option_rules.h"
 #include "amalgam/scene/coordinate_limit.h"
 #include "amalgam/scene/framing.h"
+#include "amalgam/traverse/lit_ratio.h"
 #include "amalgam/util/file_kind.h"
 #include "amalgam/util/probe.h"
 
@@ -99,7 +100,15 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
     const auto* ih = std::get_if<InstancedHierarchy>(&s.hierarchy);
     VolumeConfig volume = config.volume;
     if (light_probe().lines > 0) volume.lines = light_probe().lines;
-    if (ih) s.volumes = std::make_shared<const VolumeSet>(bake_volumes(*ih, objects, volume));
+    if (ih) {
+      VolumeSet v = bake_volumes(*ih, objects, volume);
+      // The seen-and-lit ratios serve the light probe's lit-share model alone.
+      if (!light_probe().march_self)
+        for (std::size_t m = 0; m < v.grids.size(); ++m)
+          if (v.grids[m].cells() > 0 && !v.grids[m].oriented)
+            bake_lit_ratio(ih->meshes[m], v.grids[m]);
+      s.volumes = std::make_shared<const VolumeSet>(std::move(v));
+    }
     s.volume_seconds = std::chrono::duration<double>(Clock::now() - t2).count();
   }
   s.cameras = std::move(cameras);

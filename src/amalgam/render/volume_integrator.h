@@ -183,7 +183,8 @@ class VolumeIntegrator final : private DeferSink {
     float t0 = ray.tmin, t1 = ray.tmax;
     if (!clip_to_grid(*ob.g, ob.ray.origin, ob.ray.dir, t0, t1)) return;
     if (shadow) {
-      if (ob.slot == query_.self && ob.g->oriented) return;  // in its cells' shading
+      if (ob.slot == query_.self && (ob.g->oriented || !probe_.march_self))
+        return;  // in its cells' shading
       if (!(ob.slot == query_.self ? probe_.self_cells : probe_.other_cells)) return;
       transmittance *= shadow_march(ob, ray, t0, t1, level);
       if (!(transmittance > kOpaque)) transmittance = 0.0f, done = true;
@@ -365,8 +366,22 @@ class VolumeIntegrator final : private DeferSink {
       if (!(facing_light > 0.0f)) return {};
       const float reached = g.first_hit_of(cell, g.lerp(-l)) * g.projected_area(ob.level, l);
       f = f * std::min(1.0f, reached / (s.area * facing_light * (1.0f / 65535.0f)));
+    } else if (!probe_.march_self) {
+      f = f * open_lit(ob, cell, l);
     }
     return f * e;
+  }
+
+  /// The share of the surfaces of open object `ob`'s `cell` seen along its ray that object
+  /// direction `l` lights past the object itself: their lit share toward l from the bake,
+  /// times the mesh's seen-and-lit ratio at the cell's level and the angle between the viewer
+  /// and the light (traverse/lit_ratio.h; the hot spot and where in a cell the seen surfaces
+  /// lie), at most 1.
+  float open_lit(const Object& ob, std::uint32_t cell, Vec3 l) const {
+    const CellGrid& g = *ob.g;
+    const float share = g.lit_share(ob.level, cell, l);
+    if (!probe_.hot_spot) return share;
+    return std::min(1.0f, share * g.lit_ratio_at(ob.level, dot(-ob.dir, l)));
   }
 
   /// The radiance of segment `s`'s cell (an object's or a world cell) toward the viewer along
@@ -439,7 +454,9 @@ class VolumeIntegrator final : private DeferSink {
     query_.self = !from_cell ? IH::slot(hit.id) : from_obj < kWorld ? objects_[from_obj].slot : 0;
     query_.self_full = !from_cell;
     const float cos_apart = std::clamp(dot(wo, c.ls.wi), -1.0f, 1.0f);
-    query_.sin_apart = std::sqrt(std::max(0.0f, 1.0f - cos_apart * cos_apart));
+    query_.sin_apart = !probe_.march_self && cos_apart < 0.0f
+                           ? 1.0f
+                           : std::sqrt(std::max(0.0f, 1.0f - cos_apart * cos_apart));
     ObjectLod& lod = trav_.lod();
     lod.self = query_.self, lod.self_full = query_.self_full, lod.defer_inside = true;
     lod.cells = probe_.shadow_cells;

@@ -26,6 +26,7 @@ constexpr Flag kFlags[] = {
     {"camera-triangles", &LightProbe::camera_cells},
     {"shadow-triangles", &LightProbe::shadow_cells},
     {"grain-hot-spot", &LightProbe::cone_hot_spot},
+    {"lit-share", &LightProbe::march_self},
 };
 
 }  // namespace
@@ -66,7 +67,7 @@ LightProbe LightProbe::parse(const std::string& text) {
       fail_input(std::string(kVariable), "unknown switch '" + item +
                                              "' (no-shadows, no-hot-spot, no-self-cells, "
                                              "no-other-cells, no-world-cells, camera-triangles, "
-                                             "shadow-triangles, grain-hot-spot, lines=N)");
+                                             "shadow-triangles, grain-hot-spot, lit-share, lines=N)");
     }
   }
   return p;

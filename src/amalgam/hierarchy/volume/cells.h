@@ -107,6 +107,13 @@ class CellGrid {
   std::vector<CellSurface> surface;
   /// Unit normal at the centre of each normal bin.
   std::vector<Vec3> normal_dirs;
+  /// An open mesh's seen-and-lit ratio (traverse/lit_ratio.h), per level L and angle bin k:
+  /// lit_ratio[L * kLitAngles + k]. Of the points of the mesh seen from a direction, those a
+  /// light at angle k * 180 / (kLitAngles - 1) degrees from the viewer reaches past the mesh,
+  /// over the lit share (lit_share) of the level-L cells holding them. Empty: not baked (a
+  /// closed mesh, whose cells are lit by their first-hit coverage alone).
+  static constexpr int kLitAngles = 13;
+  std::vector<float> lit_ratio;
 
   int dirs() const { return dir_res * dir_res; }
   int normal_bins() const { return normal_res * normal_res; }
@@ -140,11 +147,35 @@ class CellGrid {
   float first_hit_of(std::uint32_t cell, const OctahedralLerp& l) const {
     return lookup(first_hit, cell, l);
   }
+  /// The share of the surfaces of `cell` (of `level`) that unit direction `l` (toward the
+  /// light) reaches past the whole mesh, in projected area toward l: the cell's first-hit
+  /// coverage seen from the light times its projected area, over its surfaces' projected area
+  /// toward l (both sides of every facet).
+  float lit_share(int level, std::uint32_t cell, Vec3 l) const {
+    const std::uint16_t* hist = normals.data() + static_cast<std::size_t>(cell) * normal_bins();
+    float facing = 0.0f;
+    for (int k = 0; k < normal_bins(); ++k)
+      if (hist[k]) facing += static_cast<float>(hist[k]) * std::fabs(dot(normal_dirs[k], l));
+    const float area = surface[cell].area * facing * (1.0f / 65535.0f);
+    if (!(area > 0.0f)) return 0.0f;
+    return std::min(1.0f, first_hit_of(cell, lerp(-l)) * projected_area(level, l) / area);
+  }
+  /// The seen-and-lit ratio of `level` at the cosine `cos_apart` of the angle between the
+  /// viewer and the light (linear in the angle between bins); 1 when not baked.
+  float lit_ratio_at(int level, float cos_apart) const {
+    if (lit_ratio.empty()) return 1.0f;
+    const float x = std::acos(std::clamp(cos_apart, -1.0f, 1.0f)) *
+                    (static_cast<float>(kLitAngles - 1) / 3.14159265f);
+    const int k = std::min(static_cast<int>(x), kLitAngles - 2);
+    const float f = std::min(x - static_cast<float>(k), 1.0f);
+    const float* r = lit_ratio.data() + static_cast<std::size_t>(level) * kLitAngles;
+    return r[k] + (r[k + 1] - r[k]) * f;
+  }
   /// Bytes held.
   std::size_t bytes() const {
     return index.size() * 4 + coverage.size() * 2 + first_hit.size() * 2 + normals.size() * 2 +
            surface.size() * sizeof(CellSurface) + normal_dirs.size() * sizeof(Vec3) +
-           (index_offset.size() + level_first.size()) * 4;
+           (index_offset.size() + level_first.size()) * 4 + lit_ratio.size() * 4;
   }
 
  private:
