@@ -13,9 +13,9 @@
 // Lambert term of the side seen); per cell level, the cell holding p gives
 // - lit share: its surfaces' lit share toward l, from the bake (CellGrid::lit_share: what a
 //   closed object's cells are shaded with);
-// - lit share x ratio: the same times the mesh's seen-and-lit ratio at that level and angle
-//   (traverse/lit_ratio.h, baked from other lines and directions), at most 1: the volumetric
-//   renderer's `lit-share` model of an open object's own shadow;
+// - corrected: the same corrected by the mesh's seen-and-lit correction at that level
+//   and angle (CellGrid::seen_lit, traverse/lit_ratio.h, baked from other lines and
+//   directions): the volumetric renderer's `lit-share` model of an open object's own shadow;
 // - march from p: the transmittance through the mesh's cells from p toward l (as
 //   shadow_march with no hot spot: the cell holding the origin by the share of its mean chord
 //   ahead);
@@ -82,17 +82,6 @@ class Measure {
   Measure(const ExplicitHierarchy& h, const CellGrid& g) : h_(h), g_(g) {}
   float elevation_deg = -100.0f;  ///< >= -90: every view looks down at this angle
 
-  /// The cell (id + 1, or 0) of `level` holding point `p`, and the cell's corner.
-  std::uint32_t cell_at(int level, Vec3 p, Vec3& corner) const {
-    const Vec3 cs = g_.cell_size(level);
-    const int n = 1 << level;
-    int c[3];
-    for (int a = 0; a < 3; ++a)
-      c[a] = std::clamp(static_cast<int>(std::floor((p[a] - g_.lo[a]) / cs[a])), 0, n - 1);
-    corner = g_.lo + Vec3{cs.x * c[0], cs.y * c[1], cs.z * c[2]};
-    return g_.at(level, c[0], c[1], c[2]);
-  }
-
   /// Transmittance through the cells of `level` from `o` toward unit `l` (no hot spot).
   float march(int level, Vec3 o, Vec3 l) const {
     float t0 = 0.0f, t1 = kInfinity;
@@ -120,16 +109,12 @@ class Measure {
     // y is up in the scenes: a view `elevation_deg` down has v.y = z.
     const Vec3 v = elevation_deg >= -90.0f ? Vec3{r * std::cos(phi), z, r * std::sin(phi)}
                                            : Vec3{r * std::cos(phi), r * std::sin(phi), z};
-    Vec3 a, b;
-    basis(v, a, b);
-    const Vec3 centre = g_.lo + g_.size * 0.5f;
-    const float radius = 0.5f * length(g_.size);
     Counters counters;
     Trav trav(h_, {}, counters);
     for (int k = 0; k < lines; ++k) {
-      const float x = (2.0f * u.next() - 1.0f) * radius, y = (2.0f * u.next() - 1.0f) * radius;
-      const Ray ray = Ray::make(centre + a * x + b * y - v * (2.0f * radius), v);
-      const TraceHit hit = trav.intersect(ray, static_cast<std::uint64_t>(k));
+      const float u1 = u.next(), u2 = u.next();
+      const TraceHit hit =
+          trav.intersect(line_across(g_, v, u1, u2), static_cast<std::uint64_t>(k));
       if (hit.kind != TraceHit::Kind::kPrimitive) continue;
       for (int j = 0; j < kAngles; ++j) {
         const float theta = static_cast<float>(j) * std::numbers::pi_v<float> / (kAngles - 1);
@@ -144,7 +129,7 @@ class Measure {
         s.lit_lambert[j] += lit * lambert;
         for (int level = 0; level < g_.levels; ++level) {
           Vec3 corner;
-          const std::uint32_t c = cell_at(level, hit.surf.p, corner);
+          const std::uint32_t c = cell_holding(g_, level, hit.surf.p, &corner);
           if (c == 0) continue;
           const Vec3 cs = g_.cell_size(level);
           const Vec3 q = corner + Vec3{cs.x * u.next(), cs.y * u.next(), cs.z * u.next()};
@@ -152,7 +137,7 @@ class Measure {
           s.counted[at] += 1.0;
           const float sh = g_.lit_share(level, c - 1, l);
           s.share[at] += sh;
-          s.model[at] += std::min(1.0f, sh * g_.lit_ratio_at(level, std::cos(theta)));
+          s.model[at] += g_.seen_lit(level, v.y, std::cos(theta), sh);
           s.march_p[at] += march(level, hit.surf.p, l);
           s.march_q[at] += march(level, q, l);
           s.tri_q[at] += trav.transmittance(Ray::make(q, l), static_cast<std::uint64_t>(k));
@@ -197,7 +182,7 @@ nlohmann::json run(const ExplicitHierarchy& h, const CellGrid& g, int views, int
       row["cells"].push_back({{"level", level},
                               {"points", all.counted[at]},
                               {"lit_share", all.share[at] / n},
-                              {"lit_share_ratio", all.model[at] / n},
+                              {"lit_share_corrected", all.model[at] / n},
                               {"march_from_surface", all.march_p[at] / n},
                               {"march_from_space", all.march_q[at] / n},
                               {"triangles_from_space", all.tri_q[at] / n}});

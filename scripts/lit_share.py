@@ -58,7 +58,7 @@ def asset_section(name, what, d4, d8):
     head = "| angle | seen and lit (triangles) |"
     rule = "|---|---|"
     for L in shown:
-        head += f" L{L} lit share | L{L} x ratio | L{L} march from space |"
+        head += f" L{L} lit share | L{L} corrected | L{L} march from space |"
         rule += "---|---|---|"
     lines += [head, rule]
     for a in d4["angles"]:
@@ -69,16 +69,16 @@ def asset_section(name, what, d4, d8):
         for L in shown:
             c = a["cells"][L]
             row += (f" {c['lit_share']:.3f} ({rel(c['lit_share'], t)}) |"
-                    f" {c['lit_share_ratio']:.3f} ({rel(c['lit_share_ratio'], t)}) |"
+                    f" {c['lit_share_corrected']:.3f} ({rel(c['lit_share_corrected'], t)}) |"
                     f" {c['march_from_space']:.3f} ({rel(c['march_from_space'], t)}) |")
         lines.append(row)
     lines += ["", "Mean absolute error over the angles, per level (bake of 4 lines per finest "
               "cell; in brackets 8):", "",
-              "| level | lit share | lit share x ratio | march from space | "
+              "| level | lit share | corrected | march from space | "
               "triangles from space |", "|---|---|---|---|---|"]
     for L in range(levels):
         cells = [(mean_abs(d4, L, k), mean_abs(d8, L, k)) for k in
-                 ("lit_share", "lit_share_ratio", "march_from_space", "triangles_from_space")]
+                 ("lit_share", "lit_share_corrected", "march_from_space", "triangles_from_space")]
         lines.append(f"| {L} | " + " | ".join(f"{a:.1f} % ({b:.1f} %)" for a, b in cells) + " |")
     return lines + [""]
 
@@ -103,9 +103,10 @@ def main():
            "the cell holding the point: **lit share**, its surfaces' share lit toward the light "
            "from the bake (the cell's first-hit coverage seen from the light times its projected "
            "area, over the surfaces' projected area toward the light), blind to where the camera "
-           "is; **x ratio**, the same times the mesh's seen-and-lit ratio at that level and angle "
-           "(traverse/lit_ratio.h: baked from other lines and directions; the volumetric "
-           "renderer's `lit-share` model), at most 1; **march from space**, the "
+           "is; **corrected**, the same corrected by the mesh's seen-and-lit correction at that "
+           "level, rise of the view and angle (CellGrid::seen_lit, traverse/lit_ratio.h: baked "
+           "from other lines and directions; the volumetric renderer's `lit-share` model); "
+           "**march from space**, the "
            "transmittance through the cells from a random point of that cell, the shadow march "
            "without hot spot from a point in space; beside it in the summary **triangles from "
            "space**, the shadow ray from that random point through the triangles. In brackets: "

@@ -374,14 +374,14 @@ class VolumeIntegrator final : private DeferSink {
 
   /// The share of the surfaces of open object `ob`'s `cell` seen along its ray that object
   /// direction `l` lights past the object itself: their lit share toward l from the bake,
-  /// times the mesh's seen-and-lit ratio at the cell's level and the angle between the viewer
-  /// and the light (traverse/lit_ratio.h; the hot spot and where in a cell the seen surfaces
-  /// lie), at most 1.
+  /// corrected by the mesh's seen-and-lit correction at the cell's level and the angle between
+  /// the viewer and the light (CellGrid::seen_lit, traverse/lit_ratio.h: the hot spot and where
+  /// in a cell the seen surfaces lie).
   float open_lit(const Object& ob, std::uint32_t cell, Vec3 l) const {
     const CellGrid& g = *ob.g;
     const float share = g.lit_share(ob.level, cell, l);
     if (!probe_.hot_spot) return share;
-    return std::min(1.0f, share * g.lit_ratio_at(ob.level, dot(-ob.dir, l)));
+    return g.seen_lit(ob.level, ob.dir.y, dot(-ob.dir, l), share);
   }
 
   /// The radiance of segment `s`'s cell (an object's or a world cell) toward the viewer along

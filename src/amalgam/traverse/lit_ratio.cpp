@@ -23,20 +23,9 @@ void lit_basis(Vec3 w, Vec3& a, Vec3& b) {
   b = cross(w, a);
 }
 
-/// The level-`level` cell (id + 1, or 0) holding point `p`.
-std::uint32_t cell_holding(const CellGrid& g, int level, Vec3 p) {
-  const Vec3 cs = g.cell_size(level);
-  const int n = 1 << level;
-  int c[3];
-  for (int a = 0; a < 3; ++a)
-    c[a] = std::clamp(static_cast<int>(std::floor((p[a] - g.lo[a]) / cs[a])), 0, n - 1);
-  return g.at(level, c[0], c[1], c[2]);
-}
-
-/// Per level and angle bin: the points lit, and each point's lit share.
+/// Per level and angle bin: the points, those lit, the sum of their cells' lit shares.
 struct LitSums {
-  std::vector<double> lit;
-  std::vector<std::vector<float>> shares;
+  std::vector<double> points, lit, share;
 };
 
 void lit_view(const ExplicitHierarchy& mesh, const CellGrid& g, const LitRatioConfig& config,
@@ -45,16 +34,11 @@ void lit_view(const ExplicitHierarchy& mesh, const CellGrid& g, const LitRatioCo
   const float z = 1.0f - 2.0f * u.next(), phi = 2.0f * std::numbers::pi_v<float> * u.next();
   const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
   const Vec3 v{r * std::cos(phi), r * std::sin(phi), z};
-  Vec3 a, b;
-  lit_basis(v, a, b);
-  const Vec3 centre = g.lo + g.size * 0.5f;
-  const float radius = 0.5f * length(g.size);
   Counters counters;
   LitTrav trav(mesh, {}, counters);
   for (int k = 0; k < config.lines; ++k) {
-    const float x = (2.0f * u.next() - 1.0f) * radius, y = (2.0f * u.next() - 1.0f) * radius;
-    const TraceHit hit = trav.intersect(Ray::make(centre + a * x + b * y - v * (2.0f * radius), v),
-                                        static_cast<std::uint64_t>(k));
+    const float u1 = u.next(), u2 = u.next();
+    const TraceHit hit = trav.intersect(line_across(g, v, u1, u2), static_cast<std::uint64_t>(k));
     if (hit.kind != TraceHit::Kind::kPrimitive) continue;
     const SurfaceHit& sh = hit.surf;
     for (int j = 0; j < kAngles; ++j) {
@@ -71,46 +55,55 @@ void lit_view(const ExplicitHierarchy& mesh, const CellGrid& g, const LitRatioCo
       for (int level = 0; level < g.levels; ++level) {
         const std::uint32_t c = cell_holding(g, level, sh.p);
         if (c == 0) continue;
-        const std::size_t at = static_cast<std::size_t>(level * kAngles + j);
+        const std::size_t at = static_cast<std::size_t>(
+            (level * CellGrid::kLitRises + CellGrid::rise_bin(v.y)) * kAngles + j);
+        s.points[at] += 1.0;
         s.lit[at] += lit;
-        s.shares[at].push_back(g.lit_share(level, c - 1, l));
+        s.share[at] += g.lit_share(level, c - 1, l);
       }
     }
   }
 }
 
-/// The ratio r with sum(min(1, r x share)) = lit over `shares` (the cap applied as the
-/// renderer applies it): bisection, r in [0, 64].
-float solve_ratio(double lit, const std::vector<float>& shares) {
-  double lo = 0.0, hi = 64.0;
-  for (int it = 0; it < 40; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    double sum = 0.0;
-    for (const float x : shares) sum += std::min(1.0, mid * x);
-    (sum < lit ? lo : hi) = mid;
-  }
-  return static_cast<float>(0.5 * (lo + hi));
-}
-
 }  // namespace
 
+Ray line_across(const CellGrid& g, Vec3 v, float u1, float u2) {
+  Vec3 a, b;
+  lit_basis(v, a, b);
+  const float radius = 0.5f * length(g.size);
+  const Vec3 centre = g.lo + g.size * 0.5f;
+  const Vec3 o = centre + a * ((2.0f * u1 - 1.0f) * radius) + b * ((2.0f * u2 - 1.0f) * radius);
+  return Ray::make(o - v * (2.0f * radius), v);
+}
+
+std::uint32_t cell_holding(const CellGrid& g, int level, Vec3 p, Vec3* corner) {
+  const Vec3 cs = g.cell_size(level);
+  const int n = 1 << level;
+  int c[3];
+  for (int a = 0; a < 3; ++a)
+    c[a] = std::clamp(static_cast<int>(std::floor((p[a] - g.lo[a]) / cs[a])), 0, n - 1);
+  if (corner) *corner = g.lo + Vec3{cs.x * c[0], cs.y * c[1], cs.z * c[2]};
+  return g.at(level, c[0], c[1], c[2]);
+}
+
 void bake_lit_ratio(const ExplicitHierarchy& mesh, CellGrid& g, const LitRatioConfig& config) {
-  const std::size_t bins = static_cast<std::size_t>(g.levels) * kAngles;
-  std::vector<LitSums> per(
-      static_cast<std::size_t>(config.views),
-      LitSums{std::vector<double>(bins), std::vector<std::vector<float>>(bins)});
+  const std::size_t bins = static_cast<std::size_t>(g.levels) * CellGrid::kLitRises * kAngles;
+  const std::vector<double> zero(bins);
+  std::vector<LitSums> per(static_cast<std::size_t>(config.views), LitSums{zero, zero, zero});
   tbb::parallel_for(0, config.views,
                     [&](int i) { lit_view(mesh, g, config, i, per[static_cast<std::size_t>(i)]); });
-  g.lit_ratio.assign(bins, 1.0f);
-  tbb::parallel_for(std::size_t{0}, bins, [&](std::size_t i) {
-    double lit = 0.0;
-    std::vector<float> shares;
-    for (const LitSums& s : per) {  // in view order: the same for any thread count
-      lit += s.lit[i];
-      shares.insert(shares.end(), s.shares[i].begin(), s.shares[i].end());
-    }
-    if (lit > 0.0 && !shares.empty()) g.lit_ratio[i] = solve_ratio(lit, shares);
-  });
+  LitSums all{zero, zero, zero};
+  for (const LitSums& s : per)  // in view order: the same sums for any thread count
+    for (std::size_t i = 0; i < bins; ++i)
+      all.points[i] += s.points[i], all.lit[i] += s.lit[i], all.share[i] += s.share[i];
+  g.lit_ratio.assign(bins, 0.0f);
+  for (std::size_t i = 0; i < bins; ++i) {
+    if (!(all.points[i] > 0.0)) continue;
+    const double seen_lit = all.lit[i] / all.points[i], share = all.share[i] / all.points[i];
+    const double k = seen_lit >= share ? (seen_lit - share) / std::max(1.0 - share, 1e-9)
+                                       : seen_lit / share - 1.0;
+    g.lit_ratio[i] = static_cast<float>(std::clamp(k, -1.0, 1.0));
+  }
 }
 
 }  // namespace amalgam

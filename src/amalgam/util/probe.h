@@ -21,12 +21,11 @@ struct LightProbe {
   /// width: a candidate model, measured beside the production one.
   bool cone_hot_spot = true;
   /// `lit-share` (volumetric): an open object shadows its own surfaces as a closed one does,
-  /// by its cells' lit share toward the light from the bake, times the mesh's seen-and-lit
-  /// ratio at the cell's level and the angle between viewer and light (traverse/lit_ratio.h,
-  /// baked only under this switch; `no-hot-spot` leaves the ratio out), instead of marching its
-  /// own cells from a point in space; shadow rays leaving at more than 90 degrees from the
-  /// viewer keep no hot spot in other objects' cells. A candidate model
-  /// (docs/volumetric/lit-share.md).
+  /// by its cells' lit share toward the light from the bake, corrected for the surfaces the
+  /// camera sees (CellGrid::seen_lit, traverse/lit_ratio.h, baked only under this switch;
+  /// `no-hot-spot` leaves the correction out), instead of marching its own cells from a point
+  /// in space; shadow rays leaving at more than 90 degrees from the viewer keep no hot spot in
+  /// other objects' cells. A candidate model (docs/volumetric/lit-share.md).
   bool march_self = true;
   /// `no-self-cells`, `no-other-cells`, `no-world-cells` (volumetric): shadow rays pass the
   /// cells of the instance they leave from, of the other instances, or the world cells

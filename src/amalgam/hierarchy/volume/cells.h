@@ -107,11 +107,14 @@ class CellGrid {
   std::vector<CellSurface> surface;
   /// Unit normal at the centre of each normal bin.
   std::vector<Vec3> normal_dirs;
-  /// An open mesh's seen-and-lit ratio (traverse/lit_ratio.h), per level L and angle bin k:
-  /// lit_ratio[L * kLitAngles + k]. Of the points of the mesh seen from a direction, those a
-  /// light at angle k * 180 / (kLitAngles - 1) degrees from the viewer reaches past the mesh,
-  /// over the lit share (lit_share) of the level-L cells holding them. Empty: not baked (a
-  /// closed mesh, whose cells are lit by their first-hit coverage alone).
+  /// An open mesh's seen-and-lit correction (traverse/lit_ratio.h), per level L, rise bin e
+  /// of the view direction (rise_bin) and angle bin k: lit_ratio[(L * kLitRises + e) *
+  /// kLitAngles + k], in [-1, 1]. Of the points of the mesh seen from a direction, the share S'
+  /// a light at angle k * 180 / (kLitAngles - 1) degrees from the viewer reaches past the mesh,
+  /// against the mean lit share S (lit_share) of the level-L cells holding them: (S' - S) /
+  /// (1 - S) when S' >= S, else S' / S - 1 (seen_lit). Empty: not baked (a closed mesh, whose
+  /// cells are lit by their first-hit coverage alone).
+  static constexpr int kLitRises = 4;
   static constexpr int kLitAngles = 13;
   std::vector<float> lit_ratio;
 
@@ -160,16 +163,29 @@ class CellGrid {
     if (!(area > 0.0f)) return 0.0f;
     return std::min(1.0f, first_hit_of(cell, lerp(-l)) * projected_area(level, l) / area);
   }
-  /// The seen-and-lit ratio of `level` at the cosine `cos_apart` of the angle between the
-  /// viewer and the light (linear in the angle between bins); 1 when not baked.
-  float lit_ratio_at(int level, float cos_apart) const {
-    if (lit_ratio.empty()) return 1.0f;
+  /// The bin of a view direction whose y component (object space) is `rise`: equal steps of y
+  /// (of solid angle), so that a mesh standing on y (a tree, a tuft) has its own correction
+  /// seen from above, from the side and from below.
+  static int rise_bin(float rise) {
+    return std::clamp(static_cast<int>((rise + 1.0f) * (0.5f * kLitRises)), 0, kLitRises - 1);
+  }
+  /// The share of the surfaces a camera sees along a direction with y component `rise` (object
+  /// space) in a cell of `level` whose surfaces have lit share `share` that a light at cosine
+  /// `cos_apart` from the viewer reaches: the correction k
+  /// (lit_ratio, linear in the angle between bins) moves the share toward 1 by k (k >= 0: the
+  /// seen surfaces are lit more often, the hot spot) or scales it by 1 + k (k < 0). Linear in
+  /// the share, so that its mean over the seen surfaces is the measured one whatever the spread
+  /// of the cells' shares. `share` itself when not baked.
+  float seen_lit(int level, float rise, float cos_apart, float share) const {
+    if (lit_ratio.empty()) return share;
     const float x = std::acos(std::clamp(cos_apart, -1.0f, 1.0f)) *
                     (static_cast<float>(kLitAngles - 1) / 3.14159265f);
     const int k = std::min(static_cast<int>(x), kLitAngles - 2);
     const float f = std::min(x - static_cast<float>(k), 1.0f);
-    const float* r = lit_ratio.data() + static_cast<std::size_t>(level) * kLitAngles;
-    return r[k] + (r[k + 1] - r[k]) * f;
+    const float* r = lit_ratio.data() +
+                     static_cast<std::size_t>(level * kLitRises + rise_bin(rise)) * kLitAngles;
+    const float c = r[k] + (r[k + 1] - r[k]) * f;
+    return c >= 0.0f ? share + (1.0f - share) * c : share * (1.0f + c);
   }
   /// Bytes held.
   std::size_t bytes() const {
