@@ -10,10 +10,10 @@
 /// direction l at that angle from -v (random azimuth) and one shadow ray from each point
 /// through the triangles. Per level L, rise bin and angle bin, the share of the points lit
 /// against the mean lit share toward l of the level-L cells holding them gives the correction
-/// (CellGrid::lit_ratio). It holds what cells cannot: at fine
-/// levels the gap a camera ray came through (the hot spot, a leaf wide), at coarse levels also
-/// where in a cell the seen surfaces lie (its front, which a light near the viewer reaches
-/// more often and a light behind the cell less), and any bias of a level's lit share.
+/// (CellGrid::lit_ratio). It holds what cells cannot: at fine levels the gap a camera ray came
+/// through (the hot spot, a leaf wide), at coarse levels also where in a cell the seen surfaces
+/// lie (its front, which a light near the viewer reaches more often and a light behind the cell
+/// less), and any bias of a level's lit share.
 
 #include <cstdint>
 
