@@ -34,21 +34,13 @@ struct LightSample {
   float spread = 0.0f;     ///< disc (directional): the cone's widening per unit distance
 };
 
-/// An orthonormal basis (s, t) perpendicular to the unit vector `w`.
-inline void basis(Vec3 w, Vec3& s, Vec3& t) {
-  const float sign = std::copysign(1.0f, w.z);
-  const float a = -1.0f / (sign + w.z), b = w.x * w.y * a;
-  s = {1.0f + sign * w.x * w.x * a, sign * b, -sign * w.x};
-  t = {b, sign + w.y * w.y * a, -w.y};
-}
-
 /// A direction uniformly distributed in the cone of half-angle acos(cos_max) about unit `w`.
 inline Vec3 in_cone(Vec3 w, float cos_max, float u1, float u2) {
   const float c = 1.0f - u1 * (1.0f - cos_max);
   const float s = std::sqrt(std::max(0.0f, 1.0f - c * c));
   const float phi = 2.0f * std::numbers::pi_v<float> * u2;
   Vec3 a, b;
-  basis(w, a, b);
+  perpendiculars(w, a, b);
   return normalize(a * (s * std::cos(phi)) + b * (s * std::sin(phi)) + w * c);
 }
 
@@ -139,7 +131,7 @@ inline bool sample_sky(const Light& l, const SkyMap* map, Vec3 normal, float u1,
   const float c = std::sqrt(std::max(0.0f, 1.0f - u1));
   if (!(c > 0.0f)) return false;
   Vec3 a, b;
-  basis(normal, a, b);
+  perpendiculars(normal, a, b);
   s.wi = normalize(a * (r * std::cos(phi)) + b * (r * std::sin(phi)) + normal * c);
   s.e = l.intensity * (pi * share / c);
   return true;

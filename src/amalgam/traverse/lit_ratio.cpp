@@ -17,12 +17,6 @@ namespace {
 constexpr int kAngles = CellGrid::kLitAngles;
 using LitTrav = Traversal<ExplicitHierarchy, TraditionalLod, StochasticOpacity, SortedOrder>;
 
-/// An orthonormal pair perpendicular to unit `w`.
-void lit_basis(Vec3 w, Vec3& a, Vec3& b) {
-  a = normalize(cross(std::fabs(w.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 1, 0}, w));
-  b = cross(w, a);
-}
-
 /// Per level and angle bin: the points, those lit, the sum of their cells' lit shares.
 struct LitSums {
   std::vector<double> points, lit, share;
@@ -34,6 +28,8 @@ void lit_view(const ExplicitHierarchy& mesh, const CellGrid& g, const LitRatioCo
   const float z = 1.0f - 2.0f * u.next(), phi = 2.0f * std::numbers::pi_v<float> * u.next();
   const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
   const Vec3 v{r * std::cos(phi), r * std::sin(phi), z};
+  Vec3 p, q;  // across -v, for the light's azimuth
+  perpendiculars(-v, p, q);
   Counters counters;
   LitTrav trav(mesh, {}, counters);
   for (int k = 0; k < config.lines; ++k) {
@@ -45,8 +41,6 @@ void lit_view(const ExplicitHierarchy& mesh, const CellGrid& g, const LitRatioCo
       // A light direction at angle j * pi / (kAngles - 1) from -v, random azimuth.
       const float theta = static_cast<float>(j) * std::numbers::pi_v<float> / (kAngles - 1);
       const float turn = 2.0f * std::numbers::pi_v<float> * u.next();
-      Vec3 p, q;
-      lit_basis(-v, p, q);
       const Vec3 l = normalize(-v * std::cos(theta) +
                                (p * std::cos(turn) + q * std::sin(turn)) * std::sin(theta));
       const Vec3 side = dot(sh.normal, l) >= 0.0f ? sh.normal : -sh.normal;
@@ -69,7 +63,7 @@ void lit_view(const ExplicitHierarchy& mesh, const CellGrid& g, const LitRatioCo
 
 Ray line_across(const CellGrid& g, Vec3 v, float u1, float u2) {
   Vec3 a, b;
-  lit_basis(v, a, b);
+  perpendiculars(v, a, b);
   const float radius = 0.5f * length(g.size);
   const Vec3 centre = g.lo + g.size * 0.5f;
   const Vec3 o = centre + a * ((2.0f * u1 - 1.0f) * radius) + b * ((2.0f * u2 - 1.0f) * radius);

@@ -28,14 +28,6 @@ namespace amalgam {
 
 namespace {
 
-/// A unit vector's two unit perpendiculars (Duff et al. 2017).
-void perpendiculars(Vec3 w, Vec3& s, Vec3& t) {
-  const float sign = std::copysign(1.0f, w.z);
-  const float a = -1.0f / (sign + w.z), b = w.x * w.y * a;
-  s = {1.0f + sign * w.x * w.x * a, sign * b, -sign * w.x};
-  t = {b, sign + w.y * w.y * a, -w.y};
-}
-
 /// First hits of one direction's lines: depth along d (infinity: none) per line.
 void first_hits(const CellGrid& g, std::span<const Vec3> tris, Vec3 d, int res, float radius,
                 std::uint64_t key, std::vector<float>& depth, std::vector<float>& jx,
@@ -183,7 +175,8 @@ void bake_coverage(CellGrid& g, std::span<const Vec3> tris, const VolumeConfig& 
           const std::uint16_t* h = g.normals.data() + static_cast<std::size_t>(c) * g.normal_bins();
           float mean_cos = 0.0f;
           for (int k = 0; k < g.normal_bins(); ++k)
-            mean_cos += static_cast<float>(h[k]) * std::fabs(dot(g.normal_dirs[static_cast<std::size_t>(k)], d));
+            mean_cos += static_cast<float>(h[k]) *
+                        std::fabs(dot(g.normal_dirs[static_cast<std::size_t>(k)], d));
           const float tau = g.surface[c].area * mean_cos / 65535.0f / g.projected_area(L, d);
           store(g.coverage, c, 1.0f - std::exp(-tau));
         }
