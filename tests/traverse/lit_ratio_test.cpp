@@ -47,9 +47,9 @@ TEST(LitRatio, SameForAnyThreadCount) {
 
 // Points seen along other lines (seed 99), lit from other directions: the share a light at 30,
 // 90 and 150 degrees from the viewer reaches, through the triangles, against the cells' lit
-// share corrected (CellGrid::seen_lit), on levels 1-4. Measured when written: within 4 % (0.96 to
-// 1.01 of the truth); the lit share alone is 16-46 % low at 30 degrees (seen leaves are lit more
-// often than their cells' surfaces on average: the hot spot), which the test asserts too.
+// share corrected (CellGrid::seen_lit), on levels 1-4. Measured: within 3 % (0.975 to 1.012 of
+// the truth); the lit share alone is 15-45 % low at 30 degrees (seen leaves are lit more often
+// than their cells' surfaces on average: the hot spot), which the test asserts too.
 TEST(LitRatio, CellsTimesRatioMatchTheTrianglesOnOtherLines) {
   Baked b = baked_leaves();
   bake_lit_ratio(b.mesh, b.g);
