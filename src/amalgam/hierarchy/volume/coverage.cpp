@@ -175,8 +175,7 @@ void bake_coverage(CellGrid& g, std::span<const Vec3> tris, const VolumeConfig& 
           const std::uint16_t* h = g.normals.data() + static_cast<std::size_t>(c) * g.normal_bins();
           float mean_cos = 0.0f;
           for (int k = 0; k < g.normal_bins(); ++k)
-            mean_cos += static_cast<float>(h[k]) *
-                        std::fabs(dot(g.normal_dirs[static_cast<std::size_t>(k)], d));
+            mean_cos += static_cast<float>(h[k]) * std::fabs(dot(g.normal_dirs[static_cast<std::size_t>(k)], d));
           const float tau = g.surface[c].area * mean_cos / 65535.0f / g.projected_area(L, d);
           store(g.coverage, c, 1.0f - std::exp(-tau));
         }
