@@ -26,6 +26,11 @@ TEST(LightProbe, ParsesSwitchesAndNamesThemInOneOrder) {
   EXPECT_TRUE(p.camera_cells);
   EXPECT_EQ(p.lines, 8);
   EXPECT_EQ(p.describe(), "lines=8,no-hot-spot,shadow-triangles");
+  const LightProbe q = LightProbe::parse("lit-share,no-other-hot-spot");
+  EXPECT_TRUE(q.hot_spot);
+  EXPECT_FALSE(q.other_hot_spot);
+  EXPECT_FALSE(q.march_self);
+  EXPECT_EQ(q.describe(), "lit-share,no-other-hot-spot");
   for (const char* bad : {"no-shadow", "lines=0", "lines=65", "lines=8x", "lines="})
     EXPECT_THROW(LightProbe::parse(bad), InputError) << bad;
 }

@@ -276,7 +276,7 @@ class VolumeIntegrator final : private DeferSink {
     march_world(
         w, ray, ray.tmin, ray.tmax, trav_.lod().cell_pixels, world_level_u(key),
         [&](std::uint32_t cell, float a, float b, int) {
-          const float beside = !probe_.hot_spot
+          const float beside = !probe_.hot_spot || !probe_.other_hot_spot
                                    ? 1.0f
                                    : std::min(1.0f, 0.5f * (a + b) * query_.sin_apart /
                                                         std::max(2.0f * w.grain[cell], 1e-30f));
@@ -304,13 +304,13 @@ class VolumeIntegrator final : private DeferSink {
                             ? std::max(ray.cone_width, 1e-30f)
                             : std::max(2.0f * ob.g->grain * v_.instance_scale[ob.slot - 1], 1e-30f);
     const float apart_per_t = query_.sin_apart * length(ray.dir) / width;
+    const bool hot_spot = probe_.hot_spot && (probe_.other_hot_spot || ob.slot == query_.self);
     float tr = 1.0f;
     const int steps = march_cells(
         *ob.g, ob.level, ob.ray.origin, ob.ray.dir, t0, t1,
         [&](std::uint32_t cell, float a, float b) {
           const float pass = 1.0f - ob.g->coverage_of(cell, lerp);
-          const float beside =
-              probe_.hot_spot ? std::min(1.0f, 0.5f * (a + b) * apart_per_t) : 1.0f;
+          const float beside = hot_spot ? std::min(1.0f, 0.5f * (a + b) * apart_per_t) : 1.0f;
           const float share = starts_inside && a == t0 ? std::min(1.0f, (b - a) / chord) : 1.0f;
           tr *= std::pow(pass, beside * share);
           return tr > kOpaque;

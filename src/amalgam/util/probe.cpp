@@ -20,6 +20,7 @@ struct Flag {
 constexpr Flag kFlags[] = {
     {"no-shadows", &LightProbe::shadows},
     {"no-hot-spot", &LightProbe::hot_spot},
+    {"no-other-hot-spot", &LightProbe::other_hot_spot},
     {"no-self-cells", &LightProbe::self_cells},
     {"no-other-cells", &LightProbe::other_cells},
     {"no-world-cells", &LightProbe::world_cells},
@@ -64,10 +65,11 @@ LightProbe LightProbe::parse(const std::string& text) {
         fail_input(std::string(kVariable), "'" + item + "': lines must be 1 .. 64");
       p.lines = static_cast<int>(v);
     } else {
-      fail_input(std::string(kVariable), "unknown switch '" + item +
-                                             "' (no-shadows, no-hot-spot, no-self-cells, "
-                                             "no-other-cells, no-world-cells, camera-triangles, "
-                                             "shadow-triangles, grain-hot-spot, lit-share, lines=N)");
+      fail_input(std::string(kVariable),
+                 "unknown switch '" + item +
+                     "' (no-shadows, no-hot-spot, no-other-hot-spot, no-self-cells, "
+                     "no-other-cells, no-world-cells, camera-triangles, shadow-triangles, "
+                     "grain-hot-spot, lit-share, lines=N)");
     }
   }
   return p;

@@ -16,6 +16,10 @@ struct LightProbe {
   /// `no-hot-spot` (volumetric): cells attenuate a shadow ray over their whole chord, never
   /// only beside the camera cone that reached its origin.
   bool hot_spot = true;
+  /// `no-other-hot-spot` (volumetric): as `no-hot-spot` for the cells of the instances a shadow
+  /// ray does not leave from and the world cells only; the cells of its own instance keep theirs
+  /// (with `lit-share`, its seen-and-lit correction).
+  bool other_hot_spot = true;
   /// `grain-hot-spot` (volumetric): an object's cells keep a shadow ray's hot spot as wide as
   /// two of the object's grains (its pieces' size, as world cells do), not the camera cone's
   /// width: a candidate model, measured beside the production one.
