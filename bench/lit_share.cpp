@@ -207,6 +207,11 @@ int main(int argc, char** argv) {
   app.add_option("--lines", lines, "lines per view direction")->check(CLI::Range(1, 10000000));
   app.add_option("--lines-per-cell", lines_per_cell, "the bake's lines per finest-cell width")
       ->check(CLI::Range(1, 64));
+  LitRatioConfig ratio;
+  app.add_option("--ratio-views", ratio.views, "the seen-and-lit bake's view directions")
+      ->check(CLI::Range(1, 1000000));
+  app.add_option("--ratio-lines", ratio.lines, "the seen-and-lit bake's lines per view")
+      ->check(CLI::Range(1, 1000000));
   app.add_option("--elevation", elevation,
                  "views looking down at this angle (degrees), random azimuth; default: any");
   CLI11_PARSE(app, argc, argv);
@@ -223,7 +228,7 @@ int main(int argc, char** argv) {
       throw InputError(scene + ": no mesh " + std::to_string(mesh) + " with cells");
     const auto m = static_cast<std::size_t>(mesh);
     CellGrid g = *s.volumes->grid(m);
-    if (g.lit_ratio.empty()) bake_lit_ratio(h->meshes[m], g);
+    bake_lit_ratio(h->meshes[m], g, ratio);
     nlohmann::json out = run(h->meshes[m], g, views, lines, elevation);
     out["scene"] = scene;
     out["mesh"] = mesh;

@@ -25,8 +25,8 @@ class ExplicitHierarchy;
 class CellGrid;
 
 struct LitRatioConfig {
-  int views = 128;  ///< view directions
-  int lines = 200;  ///< lines per view direction
+  int views = 4096;  ///< view directions (the correction's noise falls with their number)
+  int lines = 50;    ///< lines per view direction
   std::uint64_t seed = 0x6c6974;
 };
 

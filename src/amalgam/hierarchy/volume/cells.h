@@ -114,8 +114,8 @@ class CellGrid {
   /// against the mean lit share S (lit_share) of the level-L cells holding them: (S' - S) /
   /// (1 - S) when S' >= S, else S' / S - 1 (seen_lit). Empty: not baked (a closed mesh, whose
   /// cells are lit by their first-hit coverage alone).
-  static constexpr int kLitRises = 4;
-  static constexpr int kLitAngles = 13;
+  static constexpr int kLitRises = 8;
+  static constexpr int kLitAngles = 25;
   std::vector<float> lit_ratio;
 
   int dirs() const { return dir_res * dir_res; }
@@ -171,20 +171,26 @@ class CellGrid {
   }
   /// The share of the surfaces a camera sees along a direction with y component `rise` (object
   /// space) in a cell of `level` whose surfaces have lit share `share` that a light at cosine
-  /// `cos_apart` from the viewer reaches: the correction k
-  /// (lit_ratio, linear in the angle between bins) moves the share toward 1 by k (k >= 0: the
-  /// seen surfaces are lit more often, the hot spot) or scales it by 1 + k (k < 0). Linear in
-  /// the share, so that its mean over the seen surfaces is the measured one whatever the spread
-  /// of the cells' shares. `share` itself when not baked.
+  /// `cos_apart` from the viewer reaches: the correction k (lit_ratio, linear in the angle
+  /// between angle bins and in the rise between the rise bins' centres) moves the share toward
+  /// 1 by k (k >= 0: the seen surfaces are lit more often, the hot spot) or scales it by 1 + k
+  /// (k < 0). Linear in the share, so that its mean over the seen surfaces is the measured one
+  /// whatever the spread of the cells' shares. `share` itself when not baked.
   float seen_lit(int level, float rise, float cos_apart, float share) const {
     if (lit_ratio.empty()) return share;
     const float x = std::acos(std::clamp(cos_apart, -1.0f, 1.0f)) *
                     (static_cast<float>(kLitAngles - 1) / 3.14159265f);
     const int k = std::min(static_cast<int>(x), kLitAngles - 2);
     const float f = std::min(x - static_cast<float>(k), 1.0f);
-    const float* r = lit_ratio.data() +
-                     static_cast<std::size_t>(level * kLitRises + rise_bin(rise)) * kLitAngles;
-    const float c = r[k] + (r[k + 1] - r[k]) * f;
+    const float y = (rise + 1.0f) * (0.5f * kLitRises) - 0.5f;  // in units of rise bins
+    const int e = std::clamp(static_cast<int>(std::floor(y)), 0, kLitRises - 2);
+    const float g = std::clamp(y - static_cast<float>(e), 0.0f, 1.0f);
+    auto at = [&](int bin) {
+      const float* r =
+          lit_ratio.data() + static_cast<std::size_t>(level * kLitRises + bin) * kLitAngles;
+      return r[k] + (r[k + 1] - r[k]) * f;
+    };
+    const float lo = at(e), c = lo + (at(e + 1) - lo) * g;
     return c >= 0.0f ? share + (1.0f - share) * c : share * (1.0f + c);
   }
   /// Bytes held.
