@@ -165,12 +165,17 @@ class Renders:
         self.seconds = 0.0
 
     def image(self, scene, args, probe="", amalgam=None):
+        return self.image_and_stats(scene, args, probe, amalgam, stats=False)[0]
+
+    def image_and_stats(self, scene, args, probe="", amalgam=None, stats=True):
+        """The image and (with `stats`) the render's stats JSON, cached side by side."""
         amalgam = amalgam or self.amalgam
         text = json.dumps(scene, sort_keys=True)
         key = hashlib.sha1("\n".join([binary_hash(amalgam), text, " ".join(args),
                                       probe]).encode()).hexdigest()[:20]
         img = os.path.join(self.folder, key + ".pfm")
-        if not os.path.exists(img):
+        st = os.path.join(self.folder, key + ".stats.json")
+        if not os.path.exists(img) or (stats and not os.path.exists(st)):
             scene_file = os.path.join(self.folder, key + ".json")
             with open(scene_file, "w") as f:
                 f.write(text)
@@ -181,12 +186,17 @@ class Renders:
             t0 = time.time()
             subprocess.run([amalgam, "render", scene_file, "--quiet", "--threads",
                             str(self.threads), "--sampler", "stratified", "--out",
-                            img + ".tmp.pfm"] + args, check=True, env=env,
-                           stdout=subprocess.DEVNULL)
+                            img + ".tmp.pfm"] + (["--stats", st + ".tmp"] if stats else []) +
+                           args, check=True, env=env, stdout=subprocess.DEVNULL)
             self.seconds += time.time() - t0
+            if stats:
+                os.replace(st + ".tmp", st)
             os.replace(img + ".tmp.pfm", img)
             os.unlink(scene_file)
-        return pfm.read_pfm(img).astype(np.float64)
+        if not stats:
+            return pfm.read_pfm(img).astype(np.float64), None
+        with open(st) as f:
+            return pfm.read_pfm(img).astype(np.float64), json.load(f)
 
 
 def tiles(l, t=32):

@@ -26,11 +26,9 @@ in out/bias-terms, keyed by --ref-amalgam's binary); timings come from each rend
 """
 
 import argparse
-import hashlib
 import json
 import math
 import os
-import subprocess
 import sys
 
 import numpy as np
@@ -38,9 +36,8 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-import pfm  # noqa: E402
 from bias_terms import SPP, VIEWS, Renders, compare, lum, variant  # noqa: E402
-from volumetric_eval import binary_hash, machine  # noqa: E402
+from volumetric_eval import machine  # noqa: E402
 
 # name: (renderer, tracer, light probe)
 CONFIGS = [
@@ -61,31 +58,7 @@ def setup(stats):
     return t["load"] + t["build"] + t["bake"] + v.get("bake_s", 0.0) + v.get("world_bake_s", 0.0)
 
 
-def timed_render(amalgam, folder, scene, args, probe, threads):
-    """The image and stats of one render, cached like bias_terms.Renders."""
-    text = json.dumps(scene, sort_keys=True)
-    key = hashlib.sha1("\n".join([binary_hash(amalgam), text, " ".join(args),
-                                  probe]).encode()).hexdigest()[:20]
-    img, stats = (os.path.join(folder, key + ext) for ext in (".pfm", ".json"))
-    if not (os.path.exists(img) and os.path.exists(stats)):
-        scene_file = os.path.join(folder, key + ".scene.json")
-        with open(scene_file, "w") as f:
-            f.write(text)
-        env = dict(os.environ)
-        env.pop("AMALGAM_LIGHT_PROBE", None)
-        if probe:
-            env["AMALGAM_LIGHT_PROBE"] = probe
-        subprocess.run([amalgam, "render", scene_file, "--quiet", "--threads", str(threads),
-                        "--sampler", "stratified", "--out", img + ".tmp.pfm", "--stats",
-                        stats + ".tmp"] + args, check=True, env=env, stdout=subprocess.DEVNULL)
-        os.replace(stats + ".tmp", stats)
-        os.replace(img + ".tmp.pfm", img)
-        os.unlink(scene_file)
-    with open(stats) as f:
-        return pfm.read_pfm(img).astype(np.float64), json.load(f)
-
-
-def measure(a, name, refs):
+def measure(a, name, refs, renders):
     scene_path, view, w, h, _, _ = VIEWS[name]
     scene = variant(os.path.join(ROOT, scene_path), "scene")
     size = ["--width", str(w), "--height", str(h)] + view
@@ -94,9 +67,9 @@ def measure(a, name, refs):
                                     "11"])
     rows = []
     for label, renderer, tracer, probe in CONFIGS:
-        runs = [timed_render(a.amalgam, a.cache, scene,
-                             size + ["--renderer", renderer, "--tracer", tracer, "--spp",
-                                     str(a.spp), "--seed", str(k)], probe, a.threads)
+        runs = [renders.image_and_stats(scene, size + ["--renderer", renderer, "--tracer", tracer,
+                                                       "--spp", str(a.spp), "--seed", str(k)],
+                                        probe)
                 for k in range(1, a.seeds + 1)]
         st = runs[0][1]
         times = [r[1]["time_s"] for r in runs]
@@ -193,13 +166,13 @@ def main():
     ap.add_argument("--ref-cache", default=os.path.join(ROOT, "out", "bias-terms"))
     ap.add_argument("--doc", help="write DIR/fallback-ceiling.md and fallback-ceiling.json")
     a = ap.parse_args()
-    os.makedirs(a.cache, exist_ok=True)
     refs = Renders(a.ref_amalgam or a.amalgam, a.ref_cache, a.threads)
+    renders = Renders(a.amalgam, a.cache, a.threads)
     rows = []
     for name in a.views.split(","):
         if name not in ("forest", "forest-aerial"):
             sys.exit(f"--views: unknown view '{name}' (forest, forest-aerial)")
-        rows += measure(a, name, refs)
+        rows += measure(a, name, refs, renders)
     if a.doc:
         write_doc(a, rows, a.doc)
 
