@@ -320,13 +320,18 @@ TEST(Outputs, AnOutputOnAMeshOrTextureTheSceneReadsIsRefused) {
                            "usemtl skin\nf 1/1 2/2 3/3\n";
   }
   { std::ofstream(scene) << R"({"meshes": [{"name": "m", "file": "m.obj"}]})"; }
-  const std::string scene_bytes = slurp(scene), mesh_bytes = slurp(mesh), tex_bytes = slurp(tex);
+  const std::string scene_bytes = slurp(scene), mesh_bytes = slurp(mesh), tex_bytes = slurp(tex),
+                    mtl_bytes = slurp(mtl);
   const std::string small = " --width 8 --height 8 --spp 1 --quiet --out " + (d / "x.png");
   for (const auto& [args, input] :
        {std::pair{"render " + scene + small + " --stats " + mesh, mesh},
         std::pair{"render " + scene + small + " --cost-image " + tex, tex},
         std::pair{"render " + scene + small + " --level-image " + (d / "sub/../tex.png"), tex},
-        std::pair{"render " + mesh + small + " --stats " + tex, tex}}) {
+        std::pair{"render " + mesh + small + " --stats " + tex, tex},
+        // The material library Assimp reads beside the OBJ: it was replaced by the stats, and
+        // deleted by a completed render whose checkpoint it was.
+        std::pair{"render " + mesh + small + " --stats " + mtl, mtl},
+        std::pair{"render " + scene + small + " --checkpoint " + mtl, mtl}}) {
     fs::create_directories(d.path / "sub");
     const CliResult r = amalgam(args);
     EXPECT_EQ(r.status, 2) << args << ": " << r.err;
@@ -336,8 +341,28 @@ TEST(Outputs, AnOutputOnAMeshOrTextureTheSceneReadsIsRefused) {
   EXPECT_EQ(slurp(scene), scene_bytes);
   EXPECT_EQ(slurp(mesh), mesh_bytes);
   EXPECT_EQ(slurp(tex), tex_bytes);
+  EXPECT_EQ(slurp(mtl), mtl_bytes);
   EXPECT_FALSE(fs::exists(d / "x.png"));
   EXPECT_EQ(amalgam("render " + scene + small).status, 0);  // the texture was read
+}
+
+// A glTF's external buffer is an input too: the stats used to replace it (exit 0), after which
+// the model no longer loaded.
+TEST(Outputs, AnOutputOnAGltfBufferIsRefused) {
+  const fs::path model = "/usr/share/assimp/models/glTF2/BoxTextured-glTF";
+  ASSERT_TRUE(fs::exists(model / "BoxTextured.gltf")) << "assimp-testmodels (scripts/deps.sh)";
+  Dir d("gltf_buffer");
+  for (const auto& f : fs::directory_iterator(model))
+    fs::copy_file(f.path(), d.path / f.path().filename());
+  const std::string gltf = d / "BoxTextured.gltf", bin = d / "BoxTextured0.bin";
+  ASSERT_TRUE(fs::exists(bin));
+  const std::string bin_bytes = slurp(bin);
+  const CliResult r = amalgam("render " + gltf + " --width 8 --height 8 --spp 1 --quiet --out " +
+                              (d / "x.png") + " --stats " + bin);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find(bin + ", which the scene "), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(bin), bin_bytes);
+  EXPECT_FALSE(fs::exists(d / "x.png"));
 }
 
 /// A PNG chunk: length, type, data, CRC (big-endian), as the PNG specification lays it out.

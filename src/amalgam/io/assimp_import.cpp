@@ -1,5 +1,6 @@
 #include "amalgam/io/assimp_import.h"
 
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -11,6 +12,7 @@
 #include <filesystem>
 #include <new>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "amalgam/io/assimp_scene.h"
@@ -38,6 +40,25 @@ class CaptureLogger : public Assimp::Logger {
   void OnInfo(const char*) override {}
   void OnWarn(const char* m) override { warnings.push_back(one_line(m, kUncut)); }
   void OnError(const char* m) override { errors.push_back(one_line(m, kUncut)); }
+};
+
+/// Assimp's file access, noting every file it opens besides the mesh itself (an OBJ's
+/// material library, a glTF's buffers and images): inputs an output must never replace.
+class RecordingIO : public Assimp::DefaultIOSystem {
+ public:
+  RecordingIO(std::string mesh, std::vector<std::string>& read)
+      : mesh_(std::move(mesh)), read_(read) {}
+  Assimp::IOStream* Open(const char* file, const char* mode) override {
+    Assimp::IOStream* stream = Assimp::DefaultIOSystem::Open(file, mode);
+    if (stream != nullptr && file != nullptr && file != mesh_ &&
+        std::find(read_.begin(), read_.end(), file) == read_.end())
+      read_.emplace_back(file);
+    return stream;
+  }
+
+ private:
+  std::string mesh_;
+  std::vector<std::string>& read_;
 };
 
 /// Log messages by which Assimp reports that it dropped or replaced corrupt data. Other
@@ -82,6 +103,7 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
                               aiProcess_FindInvalidData | aiProcess_ValidateDataStructure;
   const aiScene* scene = nullptr;
   ImportedMesh out;
+  importer.SetIOHandler(new RecordingIO(path, out.files_read));  // owned by the importer
   try {
     // Read, then bake the node transforms: cameras and lights are placed by nodes, which
     // aiProcess_PreTransformVertices removes. (ReadFile runs the validation, then the other

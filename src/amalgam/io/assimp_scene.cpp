@@ -397,7 +397,7 @@ std::vector<unsigned> read_materials(const aiScene& scene, const std::string& pa
           std::int32_t index = -1;
           bool by_name = false;
           const bool read =
-              load_texture(scene, path, ref.C_Str(), budget, t, why, out.texture_files, by_name);
+              load_texture(scene, path, ref.C_Str(), budget, t, why, out.files_read, by_name);
           if (by_name)
             notes.add("textures not where the file says, read by file name beside it", quoted(ref));
           if (read) {

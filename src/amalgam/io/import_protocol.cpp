@@ -42,7 +42,7 @@ bool send_mesh(int fd, const ImportedMesh& m) {
   const std::uint64_t counts[kCounts] = {
       m.triangles.size(), m.materials.size(),     m.dropped_degenerate, m.warnings.size(),
       m.uvs.size(),       m.textures.size(),      m.cameras.size(),     m.lights.size(),
-      m.dropped.size(),   m.texture_files.size(), m.normals.size()};
+      m.dropped.size(),   m.files_read.size(), m.normals.size()};
   if (!send_string(fd, hello()) || !write_all(fd, &status, 1) ||
       !write_all(fd, counts, sizeof counts) ||
       !write_all(fd, m.triangles.data(), m.triangles.size() * sizeof(Primitive)) ||
@@ -62,7 +62,7 @@ bool send_mesh(int fd, const ImportedMesh& m) {
   }
   for (const NamedCamera& c : m.cameras)
     if (!send_string(fd, c.name) || !write_all(fd, &c.camera, sizeof c.camera)) return false;
-  for (const auto* lines : {&m.warnings, &m.dropped, &m.texture_files})
+  for (const auto* lines : {&m.warnings, &m.dropped, &m.files_read})
     for (const std::string& w : *lines)
       if (!send_string(fd, w)) return false;
   return true;
@@ -138,7 +138,7 @@ Reply receive(int fd, std::uint64_t max_triangles) {
     if (!read_string(fd, w)) return r;
     (i < counts[3]               ? m.warnings
      : i < counts[3] + counts[8] ? m.dropped
-                                 : m.texture_files)
+                                 : m.files_read)
         .push_back(std::move(w));
   }
   // Texture indices the receiver trusts (ExplicitHierarchy::surface_at checks them again).

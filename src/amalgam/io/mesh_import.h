@@ -34,9 +34,10 @@ struct ImportedMesh {
   /// What the file holds that is not rendered (a spot light, emission, a texture that cannot
   /// be read, ...), one line each, naming it: for the user (the CLI prints them).
   std::vector<std::string> dropped;
-  /// The texture files read (beside the mesh, as resolved): inputs, like the mesh itself, that
-  /// an output must never replace (the CLI checks).
-  std::vector<std::string> texture_files;
+  /// Every other file the import read (as opened): an OBJ's material library, a glTF's
+  /// buffers, textures. Inputs, like the mesh itself, that an output must never replace (the
+  /// CLI checks).
+  std::vector<std::string> files_read;
 };
 
 /// Settings for `import_mesh`.

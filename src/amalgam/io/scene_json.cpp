@@ -313,8 +313,8 @@ class SceneParser {
       e.mesh = cached->second;
       if (warned_.insert(full.string()).second) {  // once per mesh file
         out_.inputs.push_back(full.string());
-        out_.inputs.insert(out_.inputs.end(), e.mesh->texture_files.begin(),
-                           e.mesh->texture_files.end());
+        out_.inputs.insert(out_.inputs.end(), e.mesh->files_read.begin(),
+                           e.mesh->files_read.end());
         out_.warnings.insert(out_.warnings.end(), e.mesh->dropped.begin(), e.mesh->dropped.end());
         if (!e.mesh->cameras.empty() || !e.mesh->lights.empty())
           out_.warnings.push_back(full.string() +

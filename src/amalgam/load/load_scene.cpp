@@ -63,7 +63,7 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
   d.textures = std::move(m.textures);
   d.cameras = std::move(m.cameras);
   d.warnings = std::move(m.dropped);
-  d.inputs = std::move(m.texture_files);
+  d.inputs = std::move(m.files_read);
   d.env.camera = d.cameras.empty() ? frame_camera(m.bounds) : d.cameras.front().camera;
   d.framed_camera = d.cameras.empty();
   d.default_lights = m.lights.empty();
