@@ -75,6 +75,13 @@ constexpr const char* kCorruptionMessages[] = {
     "Unable to parse property instance",  // PLY: a line shorter than its properties say
 };
 
+/// Points and lines are dropped; files are opened through a RecordingIO noting them in `read`.
+void set_up(Assimp::Importer& importer, const std::string& path, std::vector<std::string>& read) {
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  importer.SetIOHandler(new RecordingIO(path, read));  // owned by the importer
+}
+
 bool is_gltf(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -96,14 +103,12 @@ ImportedMesh import_with_assimp(const std::string& path, const ImportConfig& con
   } restore;
 
   Assimp::Importer importer;
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
-                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   constexpr unsigned kFlags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                               aiProcess_PreTransformVertices | aiProcess_SortByPType |
                               aiProcess_FindInvalidData | aiProcess_ValidateDataStructure;
   const aiScene* scene = nullptr;
   ImportedMesh out;
-  importer.SetIOHandler(new RecordingIO(path, out.files_read));  // owned by the importer
+  set_up(importer, path, out.files_read);
   try {
     // Read, then bake the node transforms: cameras and lights are placed by nodes, which
     // aiProcess_PreTransformVertices removes. (ReadFile runs the validation, then the other
