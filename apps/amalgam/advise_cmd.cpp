@@ -23,6 +23,7 @@
 #include "amalgam/util/atomic_file.h"
 #include "amalgam/util/error.h"
 #include "common.h"
+#include "render_setup.h"
 
 namespace amalgam::cli {
 namespace {
@@ -157,17 +158,42 @@ Canvas strip(const RenderOutput& ref, const std::vector<Measured>& ms, int max_l
   return c;
 }
 
-/// Refuses, before any work, outputs that cannot be written.
-void check_advise_outputs(const AdviseOptions& a) {
-  if (!a.out.empty()) {
-    if (!is_png_path(a.out)) throw InputError("--out " + a.out + ": the strip is a PNG (.png)");
-    check_writable(a.out);
+/// The files advise writes: the strip, the table and, with --keep, every render and the
+/// reference (named by candidate key).
+std::vector<OutputFile> advise_outputs(const AdviseOptions& a, const RenderOptions& base) {
+  std::vector<OutputFile> outs{{"--out", a.out}, {"--json", a.json}};
+  if (!a.keep.empty()) {
+    const std::filesystem::path dir(a.keep);
+    outs.push_back({"--keep", (dir / "reference.pfm").string()});
+    for (const Candidate& c : candidates(base))
+      outs.push_back({"--keep", (dir / (c.key + ".pfm")).string()});
   }
-  if (!a.json.empty() && a.json != "-") check_writable(a.json);
+  return outs;
+}
+
+/// Refuses, before any work, outputs that cannot be written, that are one file twice or the
+/// scene file, and a film larger than the machine's memory; creates --keep's directory (so
+/// that one that cannot be created fails now, not after every render).
+void check_advise_outputs(const AdviseOptions& a, const CommonOptions& common) {
+  if (!a.out.empty() && !is_png_path(a.out))
+    throw InputError("--out " + a.out + ": the strip is a PNG (.png)");
+  RenderOptions film = common.options;
+  film.width = a.width, film.height = a.height;
+  const std::size_t films = 1 + candidates(common.options).size();  // all held at once
+  const double bytes = static_cast<double>(film_bytes(film)) * static_cast<double>(films);
+  if (bytes > static_cast<double>(physical_memory()))
+    throw InputError("--width " + std::to_string(a.width) + " --height " +
+                     std::to_string(a.height) + ": the " + std::to_string(films) +
+                     " films held at once need " + format_bytes(bytes) +
+                     ", more than this machine's memory");
+  check_files({{"--out", a.out}, {"--json", a.json}}, common.scene);
   if (!a.keep.empty()) {
     std::error_code ec;
     if (std::filesystem::exists(a.keep, ec) && !std::filesystem::is_directory(a.keep, ec))
       throw InputError("--keep " + a.keep + ": exists and is not a directory");
+    std::filesystem::create_directories(a.keep, ec);
+    if (ec) throw InputError("--keep " + a.keep + ": cannot create the directory: " + ec.message());
+    check_files(advise_outputs(a, common.options), common.scene);
   }
 }
 
@@ -273,11 +299,12 @@ void write_json(const AdviseOptions& a, const std::string& scene, double budget,
 
 int run_advise(CommonOptions& common, const AdviseOptions& a) {
   common.finish();
-  check_advise_outputs(a);
+  check_advise_outputs(a, common);
   set_activity("loading and building " + common.scene);
   SceneFileConfig config;
   config.smooth_normals = common.smooth_normals;
   LoadedScene scene = load_scene(common.scene, common.params(), config);
+  check_files_spare_inputs(advise_outputs(a, common.options), scene);
   common.prepare(scene);
   print_warnings(scene);
 

@@ -233,13 +233,14 @@ bool write_outputs(const CommonOptions& common, const RenderExtras& extra, const
 
 /// A complete render: the checkpoint is no longer needed, and (unless --quiet) what was written
 /// is said. What is removed is the file the checkpoint was written to: through a symbolic link,
-/// its target (the link is the user's and stays); a device or FIFO is never removed.
+/// its target (the link is the user's and stays), and only if it is a checkpoint of this render
+/// (any other file at that path stays); a device or FIFO is never removed.
 void finish_complete(const RenderExtras& extra, const std::string& ckpt, const Prepared& p,
                      const RenderOutput& r, const LogRange& range) {
   try {
     const OutputTarget t = resolve_output(ckpt);
     std::error_code ec;
-    if (t.kind == OutputTarget::Kind::kFile && std::filesystem::is_regular_file(t.path, ec))
+    if (t.kind == OutputTarget::Kind::kFile && is_checkpoint_of(t.path, p.fp))
       std::filesystem::remove(t.path, ec);
   } catch (const InputError&) {  // its directory went away meanwhile: nothing to remove
   }
@@ -292,6 +293,7 @@ RenderOutput render_with_progress(const RenderOptions& o, const RenderExtras& ex
                                   const std::function<RenderOutput(const RenderControl&)>& render) {
   Progress progress(o.spp, !extra.quiet);
   auto last_checkpoint = std::chrono::steady_clock::now();
+  bool warned = false;
   RenderControl control;
   control.cancel = &g_cancel;
   control.on_pass = [&](const FilmState& st) {
@@ -299,7 +301,18 @@ RenderOutput render_with_progress(const RenderOptions& o, const RenderExtras& ex
     const auto now = std::chrono::steady_clock::now();
     if (st.spp_done < o.spp &&
         std::chrono::duration<double>(now - last_checkpoint).count() >= extra.checkpoint_every) {
-      write_checkpoint(ckpt, p.fp, st);  // survives even a SIGKILL
+      // Survives even a SIGKILL. One that cannot be written (a full disk) costs only the
+      // protection: the render goes on and its outputs are written.
+      try {
+        write_checkpoint(ckpt, p.fp, st);
+      } catch (const std::exception& e) {
+        if (!warned) {
+          progress.finish();
+          std::cerr << "amalgam: warning: checkpoint " << ckpt
+                    << " not written, the render goes on: " << e.what() << "\n";
+        }
+        warned = true;
+      }
       last_checkpoint = now;
     }
   };

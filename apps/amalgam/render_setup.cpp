@@ -3,7 +3,6 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <array>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -16,19 +15,13 @@
 namespace amalgam::cli {
 namespace {
 
-/// An output file and the option that names it.
-struct Output {
-  const char* option;
-  const std::string& path;
-};
-
 /// The files a render writes, by option (an empty path: not written).
-std::array<Output, 5> outputs(const RenderExtras& e, const std::string& ckpt) {
-  return {{{"--out", e.out},
-           {"--cost-image", e.cost_image},
-           {"--level-image", e.level_image},
-           {"--stats", e.stats},
-           {"--checkpoint", ckpt}}};
+std::vector<OutputFile> outputs(const RenderExtras& e, const std::string& ckpt) {
+  return {{"--out", e.out},
+          {"--cost-image", e.cost_image},
+          {"--level-image", e.level_image},
+          {"--stats", e.stats},
+          {"--checkpoint", ckpt}};
 }
 
 /// The --footprint value of `lod` (1, the default, where there is none), as fingerprints and
@@ -59,16 +52,19 @@ std::string fingerprint(const CommonOptions& c, const LoadedScene& scene) {
 
 void check_outputs_spare_inputs(const RenderExtras& e, const std::string& ckpt,
                                 const LoadedScene& scene) {
+  check_files_spare_inputs(outputs(e, ckpt), scene);
+}
+
+void check_files_spare_inputs(const std::vector<OutputFile>& outs, const LoadedScene& scene) {
   std::vector<std::pair<std::string, const std::string*>> inputs;  // by identity
   for (const std::string& in : scene.inputs) inputs.emplace_back(file_identity(in), &in);
-  for (const Output& o : outputs(e, ckpt)) {
+  for (const OutputFile& o : outs) {
     if (o.path.empty() || resolve_output(o.path).kind != OutputTarget::Kind::kFile) continue;
     const std::string key = file_identity(o.path);
     for (const auto& [identity, path] : inputs)
       if (identity == key)
-        throw InputError(std::string(o.option) + " " + o.path + ": " + *path +
-                         ", which the scene " + scene.name +
-                         " reads (an output never replaces an input)");
+        throw InputError(o.option + " " + o.path + ": " + *path + ", which the scene " +
+                         scene.name + " reads (an output never replaces an input)");
   }
 }
 
@@ -85,23 +81,26 @@ void check_outputs(const RenderExtras& e, const std::string& ckpt, const RenderO
   if (!e.level_image.empty() && !is_image_path(e.level_image))
     throw InputError("--level-image " + e.level_image +
                      ": unsupported image format (expected .png, .exr or .pfm)");
+  check_files(outputs(e, ckpt), scene);
+}
+
+void check_files(const std::vector<OutputFile>& outs, const std::string& scene) {
   std::error_code ec;
   const bool scene_file = scene.rfind("builtin:", 0) != 0 && std::filesystem::exists(scene, ec);
   const std::string input = scene_file ? file_identity(scene) : std::string();
-  std::vector<std::pair<std::string, const char*>> files;  // regular files, by identity
-  for (const Output& o : outputs(e, ckpt)) {
+  std::vector<std::pair<std::string, const std::string*>> files;  // regular files, by identity
+  for (const OutputFile& o : outs) {
     if (o.path.empty()) continue;
     check_writable(o.path);
     const OutputTarget t = resolve_output(o.path);
     if (t.kind != OutputTarget::Kind::kFile) continue;  // devices and "-" may be shared
     const std::string key = file_identity(o.path);
     if (key == input)
-      throw InputError(std::string(o.option) + " " + o.path + ": the scene " + scene +
+      throw InputError(o.option + " " + o.path + ": the scene " + scene +
                        " itself (an output never replaces an input)");
     for (const auto& [other, option] : files)
-      if (other == key)
-        throw InputError(std::string(o.option) + " " + o.path + ": the same file as " + option);
-    files.emplace_back(key, o.option);
+      if (other == key) throw InputError(o.option + " " + o.path + ": the same file as " + *option);
+    files.emplace_back(key, &o.option);
   }
 }
 

@@ -18,6 +18,21 @@ namespace amalgam::cli {
 /// as applied). A checkpoint is only resumed under the same fingerprint.
 std::string fingerprint(const CommonOptions& c, const LoadedScene& scene);
 
+/// An output file and the option that names it (an empty path: not written).
+struct OutputFile {
+  std::string option;
+  std::string path;
+};
+
+/// Every subcommand's check of its output files before any work: each writable, no two the
+/// same file, none the scene file (by file identity: device and inode, or the resolved path of
+/// a new file). Throws InputError.
+void check_files(const std::vector<OutputFile>& outs, const std::string& scene);
+
+/// Once the scene is loaded, before anything is written: no output on a file it read (the
+/// meshes a scene file names and every file their import read). Throws InputError.
+void check_files_spare_inputs(const std::vector<OutputFile>& outs, const LoadedScene& scene);
+
 /// Checks every output path before any work: an image path must name a format we write, every
 /// path must be writable, no two outputs may be the same file and none may be the scene file
 /// (compared by file identity: device and inode, or the resolved path of a new file). Throws

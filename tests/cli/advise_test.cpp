@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -100,6 +101,49 @@ TEST(Advise, RefusesBadOutputsAndRendererOptions) {
     EXPECT_EQ(r.status, 2) << bad << ": " << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << bad << ": " << r.out;
   }
+}
+
+// Every output goes through render's checks, before any work: advise used to replace the
+// scene with --json, the scene's sky map with --out or with a --keep image of the same name,
+// and write one file twice, all with exit 0.
+TEST(Advise, AnOutputNeverReplacesAnInputOrAnotherOutput) {
+  const fs::path d = scratch_dir("amalgam-advise-inputs");
+  // Two scenes under a sky map: one a PNG (what --out writes), one named as --keep's reference.
+  const std::string png = (d / "map.png").string(), pfm = (d / "reference.pfm").string();
+  for (const std::string& map : {png, pfm})
+    ASSERT_EQ(amalgam_cli("render builtin:prisms --set depth=3 --width 8 --height 4 --spp 1 "
+                          "--quiet --out " +
+                          map)
+                  .status,
+              0);
+  const std::string scene = (d / "s.json").string(), keep_scene = (d / "k.json").string(),
+                    strip = (d / "strip.png").string();
+  for (const auto& [file, map] :
+       {std::pair{scene, "map.png"}, std::pair{keep_scene, "reference.pfm"}})
+    std::ofstream(file) << R"({"spheres": [{"centre": [0, 0, 0], "radius": 1}],
+      "lights": [{"type": "sky", "map": ")"
+                        << map << R"("}]})";
+  const std::string scene_bytes = test::slurp(scene), png_bytes = test::slurp(png),
+                    pfm_bytes = test::slurp(pfm);
+  const std::string size = " --width 16 --height 12 --time 0.01 ";
+  const std::string small = "advise " + scene + size;
+  for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+           {small + "--json " + scene, "an output never replaces an input"},
+           {small + "--out " + png, "an output never replaces an input"},
+           {"advise " + keep_scene + size + "--keep " + d.string(),
+            "an output never replaces an input"},
+           {small + "--out " + strip + " --json " + strip, "the same file as --out"},
+           {small + "--keep /proc/amalgam-advise", "cannot create the directory"},
+           {"advise " + scene + " --width 200000 --height 200000", "films held at once need"}}) {
+    const test::CommandResult r = amalgam_cli(args);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.out;
+    EXPECT_NE(r.out.find(says), std::string::npos) << args << ": " << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << args << ": " << r.out;
+  }
+  EXPECT_EQ(test::slurp(scene), scene_bytes);
+  EXPECT_EQ(test::slurp(png), png_bytes);
+  EXPECT_EQ(test::slurp(pfm), pfm_bytes);
+  EXPECT_FALSE(fs::exists(strip));
 }
 
 }  // namespace advise_test

@@ -346,6 +346,50 @@ TEST(Outputs, AnOutputOnAMeshOrTextureTheSceneReadsIsRefused) {
   EXPECT_EQ(amalgam("render " + scene + small).status, 0);  // the texture was read
 }
 
+// A completed render removes its checkpoint only if the file at that path is one of this render:
+// any other file there (notes, a user's own OUT.ckpt of something else) used to be deleted.
+TEST(Outputs, ACompletedRenderRemovesOnlyItsOwnCheckpoint) {
+  Dir d("own_checkpoint");
+  const std::string notes = d / "notes.txt", ckpt = d / "x.png.ckpt";
+  { std::ofstream(notes) << "my notes\n"; }
+  { std::ofstream(ckpt) << "AMALGAM-CHECKPOINT-5 but not ours\n"; }
+  const std::string small =
+      "render builtin:prisms --set depth=3 --width 8 --height 8 --spp 2 "
+      "--quiet --out " +
+      (d / "x.png");
+  for (const std::string& args : {small + " --checkpoint " + notes, small}) {
+    const CliResult r = amalgam(args);
+    EXPECT_EQ(r.status, 0) << args << ": " << r.err;
+  }
+  EXPECT_EQ(slurp(notes), "my notes\n");
+  EXPECT_EQ(slurp(ckpt), "AMALGAM-CHECKPOINT-5 but not ours\n");
+  // Its own checkpoint, written after each pass but the last, is removed when the render
+  // completes.
+  const std::string ours = d / "ours.ckpt";
+  // (256 x 256 pixels: about 2^16 rays per pass, so one sample per pass.)
+  const std::string args =
+      "render builtin:prisms --set depth=3 --width 256 --height 256 "
+      "--quiet --out " +
+      (d / "y.png") + " --checkpoint " + ours;
+  ASSERT_EQ(amalgam(args + " --spp 3 --checkpoint-every 0").status, 0);
+  EXPECT_FALSE(fs::exists(ours));
+}
+
+// A periodic checkpoint that cannot be written (a full disk) is one warning: the render goes on
+// and writes its outputs. It used to end the render with exit 1 and no image.
+TEST(Outputs, ACheckpointThatCannotBeWrittenIsAWarning) {
+  Dir d("full_checkpoint");
+  const CliResult r = amalgam(
+      "render builtin:prisms --set depth=3 --width 256 --height 256 --spp 3 --quiet "
+      "--checkpoint-every 0 --checkpoint /dev/full --out " +
+      (d / "x.png") + " --stats " + (d / "s.json"));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: checkpoint /dev/full not written"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_TRUE(fs::exists(d / "x.png"));
+  EXPECT_TRUE(fs::exists(d / "s.json"));
+}
+
 // A glTF's external buffer is an input too: the stats used to replace it (exit 0), after which
 // the model no longer loaded.
 TEST(Outputs, AnOutputOnAGltfBufferIsRefused) {

@@ -91,6 +91,29 @@ void write_checkpoint(const std::string& path, const std::string& fingerprint,
   write_file_atomic(path, bytes);
 }
 
+bool is_checkpoint_of(const std::string& path, const std::string& fingerprint) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) return false;
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat info {};
+  if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) return false;
+  std::string expect(kMagic, sizeof kMagic);
+  put(expect, static_cast<std::uint64_t>(fingerprint.size()));
+  expect += fingerprint;
+  std::string head(expect.size(), '\0');
+  std::size_t got = 0;
+  while (got < head.size()) {
+    const ssize_t r = ::pread(fd, head.data() + got, head.size() - got, static_cast<off_t>(got));
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) return false;
+    got += static_cast<std::size_t>(r);
+  }
+  return head == expect;
+}
+
 FilmState read_checkpoint(const std::string& path, const std::string& fingerprint) {
   // Opened without waiting (a FIFO would wait for a writer) and refused unless a regular file:
   // a device or a FIFO may never end, and only a file has a size to check the header against.

@@ -19,6 +19,11 @@ void write_checkpoint(const std::string& path, const std::string& fingerprint,
 /// was written for a different fingerprint.
 FilmState read_checkpoint(const std::string& path, const std::string& fingerprint);
 
+/// True when `path` is a regular file that begins as a checkpoint written for `fingerprint`
+/// (its magic and fingerprint; the rest is not read). False on any error: what a completed
+/// render may remove is only its own checkpoint, never a file that merely sits at that path.
+bool is_checkpoint_of(const std::string& path, const std::string& fingerprint);
+
 /// The checksum a checkpoint ends with (8 bytes), of all the bytes before it: for the tests and
 /// the fuzzer (fuzz/checkpoint_fuzz.cpp), which make checkpoints that pass it to reach the
 /// checks behind it.
