@@ -176,11 +176,23 @@ void add_advise(CLI::App& app, Commands& c) {
                        "write every render and the reference as PFM into this directory");
 }
 
+/// Refuses an empty value given to any option or argument of `app` and the subcommands parsed
+/// (`--eye ''`, `--stats ''`): it used to be taken as not given.
+void refuse_empty_values(const CLI::App& app) {
+  for (const CLI::Option* opt : app.get_options()) {
+    if (opt->count() == 0 || opt->get_type_size_max() == 0) continue;  // not given, or a flag
+    for (const std::string& v : opt->results())
+      if (v.empty()) throw CLI::ValidationError(opt->get_name(false, true), "an empty value ''");
+  }
+  for (const CLI::App* sub : app.get_subcommands()) refuse_empty_values(*sub);
+}
+
 /// Parses the command line; returns the exit status when it ends here (help, version, a
 /// mistake: one line naming it and the help to read, exit 2).
 std::optional<int> parse(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
+    refuse_empty_values(app);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {

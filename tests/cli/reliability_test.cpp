@@ -346,6 +346,35 @@ TEST(Outputs, AnOutputOnAMeshOrTextureTheSceneReadsIsRefused) {
   EXPECT_EQ(amalgam("render " + scene + small).status, 0);  // the texture was read
 }
 
+// An empty value is refused in one line, exit 2, before any work: `--eye ''` and the like used
+// to be taken as not given (an empty --stats or --checkpoint silently wrote nothing).
+TEST(BadInput, AnEmptyValueIsRefusedInOneLine) {
+  Dir d("empty_values");
+  const std::string img = d / "a.pfm", out = d / "x.png";
+  ASSERT_EQ(amalgam("render builtin:prisms --set depth=3 --width 8 --height 8 --spp 1 --quiet "
+                    "--out " +
+                    img)
+                .status,
+            0);
+  std::vector<std::string> commands;
+  for (const char* option : {"--eye", "--look-at", "--up", "--fov", "--cost-range", "--camera",
+                             "--stats", "--checkpoint", "--cost-image", "--level-image"})
+    commands.push_back("render builtin:prisms --width 8 --height 8 --spp 1 --out " + out + " " +
+                       option + " ''");
+  commands.push_back("render '' --out " + out);
+  commands.push_back("compare " + img + " " + img + " --error-image ''");
+  commands.push_back("trace builtin:prisms --origin ''");
+  commands.push_back("trace builtin:prisms --direction ''");
+  commands.push_back("advise builtin:prisms --json ''");
+  for (const std::string& args : commands) {
+    const CliResult r = amalgam(args);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.err;
+    EXPECT_NE(r.err.find("an empty value"), std::string::npos) << args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(out));
+}
+
 // A completed render removes its checkpoint only if the file at that path is one of this render:
 // any other file there (notes, a user's own OUT.ckpt of something else) used to be deleted.
 TEST(Outputs, ACompletedRenderRemovesOnlyItsOwnCheckpoint) {
@@ -477,7 +506,10 @@ TEST(Numbers, OutOfRangeIsRefusedWithTheRangeNotClamped) {
   for (const char* seed : {"18446744073709551616", "1e23", "-1", "2^63", "0x10", "1.5", ""}) {
     const CliResult r = amalgam(kSmall + out + " --seed '" + seed + "'");
     EXPECT_EQ(r.status, 2) << seed << ": " << r.err;
-    EXPECT_NE(r.err.find("expected an integer in [0, 18446744073709551615]"), std::string::npos)
+    // (An empty value is refused as for every option: BadInput.AnEmptyValueIsRefusedInOneLine.)
+    EXPECT_NE(r.err.find(*seed ? "expected an integer in [0, 18446744073709551615]"
+                               : "--seed: an empty value"),
+              std::string::npos)
         << seed << ": " << r.err;
   }
   EXPECT_EQ(amalgam(kSmall + out + " --seed 18446744073709551615").status, 0);
@@ -516,7 +548,7 @@ TEST(Numbers, NanEmptyAndOutOfRangeValuesAreRefusedAsElsewhere) {
       {kSmall + " --rank-timeout 0", "expected seconds in [0.001, 1e9]"},
       {kSmall + " --checkpoint-every nan", "expected seconds in [0, 1e9]"},
       {kSmall + " --checkpoint-every ''", "expected seconds in [0, 1e9]"},
-      {kSmall + " --max-memory ''", "expected a byte count"},
+      {kSmall + " --max-memory ''", "--max-memory: an empty value"},
       {kSmall + " --eye 1e13,0,0", "within [-1e12, 1e12]"},
       {kSmall + " --look-at 0,0,-2e12", "within [-1e12, 1e12]"},
       {kSmall + " --up 1e20,0,0", "within [-1e12, 1e12]"},
