@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
-#include <functional>
 #include <set>
 #include <sstream>
 #include <vector>
 
+#include "amalgam/io/scene_json.h"
 #include "amalgam/util/error.h"
 
 namespace amalgam {
@@ -53,37 +53,60 @@ std::string describe_overflow(const json::out_of_range& e, const std::string& te
          "is out of the range of a double";
 }
 
-/// Refuses a key given twice in one object (nlohmann keeps the last silently, so a scene file
-/// with two "camera" objects rendered the second): follows the parse as a stack of open
-/// objects and arrays, to name the object by its JSON pointer.
-class DuplicateKeyCheck {
+/// A first pass over the text (SAX: nothing is built) that refuses a key given twice in one
+/// object (nlohmann keeps the last silently, so a scene file with two "camera" objects rendered
+/// the second) and sizes the document before it is built. It follows the parse as a stack of
+/// open objects and arrays, to name the object by its JSON pointer. (nlohmann's callback
+/// parser did the same check in time quadratic in an array's length: it rescans the array for
+/// discarded values at the end of every object in it.)
+class FirstPass : public nlohmann::json_sax<json> {
  public:
-  explicit DuplicateKeyCheck(const std::string& file) : file_(file) {}
+  explicit FirstPass(const std::string& file) : file_(file) {}
 
-  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
-    switch (event) {
-      case json::parse_event_t::object_start:
-      case json::parse_event_t::array_start:
-        open_.push_back({event == json::parse_event_t::object_start, {}, {}, 0});
-        break;
-      case json::parse_event_t::key: {
-        Open& o = open_.back();
-        o.key = parsed.get<std::string>();
-        if (!o.keys.insert(o.key).second)
-          throw InputError(file_ + ": " + (pointer().empty() ? "top level" : pointer()) +
-                           ": key \"" + one_line(o.key, 80) + "\" given twice");
-        break;
-      }
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-        open_.pop_back();
-        element_done();
-        break;
-      case json::parse_event_t::value:
-        element_done();
-        break;
-    }
+  /// Bytes the document takes once built (libstdc++'s node and vector sizes, malloc's
+  /// rounding): a 16-byte value each, a map and its nodes for an object, a vector grown by
+  /// doubling for an array, a heap buffer for a string or key beyond the short-string buffer.
+  std::uint64_t bytes() const { return bytes_ + 16; }
+
+  bool null() override { return value(); }
+  bool boolean(bool) override { return value(); }
+  bool number_integer(number_integer_t) override { return value(); }
+  bool number_unsigned(number_unsigned_t) override { return value(); }
+  bool number_float(number_float_t, const string_t&) override { return value(); }
+  bool string(string_t& s) override {
+    bytes_ += 48 + heap(s.size());
+    return value();
+  }
+  bool binary(binary_t&) override { return value(); }
+  bool start_object(std::size_t) override {
+    bytes_ += 64;
+    open_.push_back({true, {}, {}, 0});
     return true;
+  }
+  bool key(string_t& k) override {
+    bytes_ += 96 + heap(k.size());
+    Open& o = open_.back();
+    o.key = k;
+    if (!o.keys.insert(o.key).second)
+      throw InputError(file_ + ": " + (pointer().empty() ? "top level" : pointer()) + ": key \"" +
+                       one_line(o.key, 80) + "\" given twice");
+    return true;
+  }
+  bool end_object() override { return close(); }
+  bool start_array(std::size_t) override {
+    bytes_ += 32;
+    open_.push_back({false, {}, {}, 0});
+    return true;
+  }
+  bool end_array() override {
+    bytes_ += 32 * open_.back().index;  // 16 per element, and the spare capacity of doubling
+    return close();
+  }
+  /// Rethrows nlohmann's own exception: parse_json turns it into one line.
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) override {
+    if (const auto* p = dynamic_cast<const json::parse_error*>(&e)) throw *p;
+    if (const auto* o = dynamic_cast<const json::out_of_range*>(&e)) throw *o;
+    throw InputError(file_ + ": invalid JSON: " + std::string(e.what()));
   }
 
  private:
@@ -94,8 +117,15 @@ class DuplicateKeyCheck {
     std::size_t index;           ///< an array's current element
   };
 
-  void element_done() {
+  static std::uint64_t heap(std::size_t n) { return n > 15 ? (n + 1 + 15) / 16 * 16 : 0; }
+
+  bool value() {
     if (!open_.empty() && !open_.back().object) ++open_.back().index;
+    return true;
+  }
+  bool close() {
+    open_.pop_back();
+    return value();
   }
 
   /// The JSON pointer of the innermost open object or array.
@@ -109,14 +139,21 @@ class DuplicateKeyCheck {
 
   const std::string& file_;
   std::vector<Open> open_;
+  std::uint64_t bytes_ = 0;
 };
 
 }  // namespace
 
-json parse_json(const std::string& text, const std::string& file) {
+json parse_json(const std::string& text, const std::string& file, const JsonLimit& limit) {
   try {
-    DuplicateKeyCheck check(file);
-    return json::parse(text, std::ref(check), /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    FirstPass first(file);
+    json::sax_parse(text, &first, json::input_format_t::json, /*strict=*/true,
+                    /*ignore_comments=*/true);
+    const std::uint64_t need = first.bytes() + text.size();  // the text lives on meanwhile
+    if (limit.max_bytes != 0 && need > limit.max_bytes)
+      throw InputError(file + ": its JSON needs about " + format_bytes(static_cast<double>(need)) +
+                       " once read (estimated before reading it), more than " + limit.name);
+    return json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
   } catch (const json::parse_error& e) {
     throw InputError(file + ": " + describe_parse_error(e, text));
   } catch (const json::out_of_range& e) {

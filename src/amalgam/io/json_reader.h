@@ -15,10 +15,19 @@
 
 namespace amalgam {
 
-/// Parses `text` (comments allowed). Throws InputError "<file>: line L, column C: invalid
-/// JSON: <what>" on a syntax error, and likewise for a number beyond the range of a double;
-/// "<file>: <pointer of the object>: key "K" given twice" for a duplicate key.
-nlohmann::json parse_json(const std::string& text, const std::string& file);
+/// The bytes a parsed document may take (0: no limit), and how messages name the limit.
+struct JsonLimit {
+  std::uint64_t max_bytes = 0;
+  std::string name = "the memory limit";
+};
+
+/// Parses `text` (comments allowed), in time linear in its length. Throws InputError "<file>:
+/// line L, column C: invalid JSON: <what>" on a syntax error, and likewise for a number beyond
+/// the range of a double; "<file>: <pointer of the object>: key "K" given twice" for a
+/// duplicate key; "<file>: its JSON needs about ..." when the document, sized in a first pass
+/// that builds nothing, would take more than `limit`.
+nlohmann::json parse_json(const std::string& text, const std::string& file,
+                          const JsonLimit& limit = {});
 
 /// A value of a document with its JSON pointer ("/lights/0/intensity"; "" for the root).
 struct JsonValue {

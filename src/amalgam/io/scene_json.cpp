@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -71,7 +72,7 @@ class SceneParser {
       if (placed_.count(m.name)) everything += static_cast<double>(m.mesh->triangles.size());
     for (const Placement& p : placements)
       everything +=
-          static_cast<double>(p.mesh->mesh->triangles.size()) * static_cast<double>(p.where.size());
+          static_cast<double>(p.mesh->mesh->triangles.size()) * static_cast<double>(p.count);
     // With config_.objects every mesh placed stays an object of its own (an instance).
     const bool objects = config_.objects;
     const bool expand_all =
@@ -90,10 +91,9 @@ class SceneParser {
       p.expand = !objects &&
                  (expand_all || p.mesh->mesh->triangles.size() < config_.instance_min_triangles);
       if (p.expand) {
-        add_count(total, static_cast<double>(p.mesh->mesh->triangles.size()) * p.where.size(),
-                  p.ptr);
+        add_count(total, static_cast<double>(p.mesh->mesh->triangles.size()) * p.count, p.ptr);
       } else {
-        kept += p.where.size();
+        kept += p.count;
         if (kept > config_.max_instances)
           r_.fail(p.ptr, "the scene would hold " + fmt(static_cast<double>(kept)) +
                              " instances, more than the limit of " +
@@ -140,11 +140,11 @@ class SceneParser {
     for (const Placement& p : placements) {
       const auto material = p.material ? p.material : p.mesh->material;
       if (p.expand) {
-        for (const Affine& a : p.where) place(*p.mesh, a, material);
+        for (const Affine& a : p.where()) place(*p.mesh, a, material);
       } else {
         const std::uint32_t mesh = instanced_mesh(*p.mesh, material);
         const Bbox object = object_bounds_[mesh];
-        for (const Affine& a : p.where) {
+        for (const Affine& a : p.where()) {
           Instance in;
           for (int i = 0; i < 3; ++i)
             for (int k = 0; k < 4; ++k) in.to_world.m[i][k] = static_cast<float>(a.m[i][k]);
@@ -181,7 +181,9 @@ class SceneParser {
  private:
   struct Placement {
     const MeshEntry* mesh;
-    std::vector<Affine> where;
+    /// Generates the transforms once the whole scene's counts are checked against the limits.
+    std::function<std::vector<Affine>()> where;
+    std::size_t count = 0;  ///< of where()
     std::optional<std::uint32_t> material;
     std::string ptr;
     bool expand = true;  ///< into triangles, or kept as instances
@@ -313,8 +315,7 @@ class SceneParser {
       e.mesh = cached->second;
       if (warned_.insert(full.string()).second) {  // once per mesh file
         out_.inputs.push_back(full.string());
-        out_.inputs.insert(out_.inputs.end(), e.mesh->files_read.begin(),
-                           e.mesh->files_read.end());
+        out_.inputs.insert(out_.inputs.end(), e.mesh->files_read.begin(), e.mesh->files_read.end());
         out_.warnings.insert(out_.warnings.end(), e.mesh->dropped.begin(), e.mesh->dropped.end());
         if (!e.mesh->cameras.empty() || !e.mesh->lights.empty())
           out_.warnings.push_back(full.string() +
@@ -335,6 +336,9 @@ class SceneParser {
           r_.fail(sub->ptr, "subdividing " + std::to_string(levels) + " times gives " + fmt(tris) +
                                 " triangles, which alone take " + format_bytes(bytes) +
                                 ", more than " + config_.limit_name);
+        held_ += levels > 0 ? bytes : 0.0;  // a finer copy per entry, all held at once
+        if (const std::string why = scene_json::beyond_limit(held_, config_); !why.empty())
+          r_.fail(sub->ptr, "the meshes so far, subdivided, need at least " + why);
         if (levels > 0) {
           ImportedMesh fine = *e.mesh;
           fine.triangles = subdivide(e.mesh->triangles, levels);
@@ -375,7 +379,7 @@ class SceneParser {
                     (list.empty() ? std::string("no meshes are defined") : "meshes: " + list) +
                     ")");
       }
-      Placement p{it->second, {}, std::nullopt, in.ptr};
+      Placement p{it->second, {}, 0, std::nullopt, in.ptr};
       const Affine local = in.j.contains("transform")
                                ? scene_json::read_transform(r_, JsonReader::child(in, "transform"))
                                : Affine{};
@@ -383,31 +387,36 @@ class SceneParser {
       const int kinds =
           in.j.contains("transforms") + in.j.contains("grid") + in.j.contains("scatter");
       if (kinds != 1) r_.fail(in.ptr, "expected exactly one of 'transforms', 'grid' or 'scatter'");
-      std::vector<Affine> where;
+      const std::size_t triangles = it->second->mesh->triangles.size();
       if (auto t = r_.find(in, "transforms")) {
+        std::vector<Affine> where;
         for (const JsonValue& e : r_.items(*t)) where.push_back(scene_json::read_transform(r_, e));
+        p.count = where.size();
+        p.where = [where, local] {
+          std::vector<Affine> w = where;
+          for (Affine& a : w) a = a * local;
+          return w;
+        };
       } else if (auto g = r_.find(in, "grid")) {
-        where = read_grid(*g, it->second->mesh->triangles.size());
+        const GridPattern grid = scene_json::read_grid(r_, *g);
+        p.count = static_cast<std::size_t>(grid.nx * grid.nz);
+        add_instances_check(static_cast<double>(p.count), triangles, g->ptr);
+        p.where = [grid, local] { return placed(grid_placements(grid), local); };
       } else {
-        where = read_scatter(r_.require(in, "scatter"), it->second->mesh->triangles.size());
+        const JsonValue sc = r_.require(in, "scatter");
+        const ScatterPattern scatter = scene_json::read_scatter(r_, sc);
+        p.count = static_cast<std::size_t>(scatter.count);
+        add_instances_check(static_cast<double>(p.count), triangles, sc.ptr);
+        p.where = [scatter, local] { return placed(scatter_placements(scatter), local); };
       }
-      for (Affine& a : where) a = a * local;
-      p.where = std::move(where);
       out.push_back(std::move(p));
     }
     return out;
   }
 
-  std::vector<Affine> read_grid(const JsonValue& v, std::size_t triangles) const {
-    const GridPattern grid = scene_json::read_grid(r_, v);
-    add_instances_check(static_cast<double>(grid.nx * grid.nz), triangles, v.ptr);
-    return grid_placements(grid);
-  }
-
-  std::vector<Affine> read_scatter(const JsonValue& v, std::size_t triangles) const {
-    const ScatterPattern scatter = scene_json::read_scatter(r_, v);
-    add_instances_check(static_cast<double>(scatter.count), triangles, v.ptr);
-    return scatter_placements(scatter);
+  static std::vector<Affine> placed(std::vector<Affine> where, const Affine& local) {
+    for (Affine& a : where) a = a * local;
+    return where;
   }
 
   /// Fails before the generator allocates its transforms when its instances alone would hold
@@ -453,39 +462,31 @@ class SceneParser {
   std::set<std::string> warned_;  ///< mesh files whose warnings are passed on
   std::map<std::pair<const MeshEntry*, std::int64_t>, std::uint32_t> instanced_;
   std::vector<Bbox> object_bounds_;  ///< per instanced mesh
+  double held_ = 0;                  ///< bytes of the subdivided meshes' copies
 };
-
-/// The offset of the first byte that is not part of well-formed UTF-8 (or a NUL), or npos.
-std::size_t first_invalid_utf8(const std::string& s) {
-  for (std::size_t i = 0; i < s.size();) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    int n = c < 0x80 ? 0 : (c >> 5) == 0x6 ? 1 : (c >> 4) == 0xe ? 2 : (c >> 3) == 0x1e ? 3 : -1;
-    if (c == 0 || n < 0 || i + static_cast<std::size_t>(n) >= s.size()) return i;
-    for (int k = 1; k <= n; ++k)
-      if ((static_cast<unsigned char>(s[i + static_cast<std::size_t>(k)]) >> 6) != 0x2) return i;
-    i += static_cast<std::size_t>(n) + 1;
-  }
-  return std::string::npos;
-}
 
 }  // namespace
 
 SceneDescription parse_scene_json(const std::string& text, const std::string& path,
                                   const SceneFileConfig& config) {
-  const json doc = parse_json(text, path);
+  const json doc = parse_json(text, path, {config.max_bytes, config.limit_name});
   return SceneParser(path, config).parse(doc);
 }
 
 SceneDescription read_scene_json(const std::string& path, const SceneFileConfig& config) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) throw InputError(path + ": no such file");
+  // Read, the text is held twice (the stream's buffer and its copy): refused before that.
+  if (const std::string why = scene_json::beyond_limit(2.0 * fs::file_size(path, ec), config);
+      !ec && !why.empty())
+    throw InputError(path + ": reading the file needs " + why);
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
   in.peek();
   if (in && in.eof()) throw InputError(path + ": empty file (a scene file is a JSON object)");
   if (!in || !(text << in.rdbuf())) throw InputError(path + ": cannot read the file");
   const std::string bytes = text.str();
-  if (const std::size_t bad = first_invalid_utf8(bytes); bad != std::string::npos)
+  if (const std::size_t bad = scene_json::first_invalid_utf8(bytes); bad != std::string::npos)
     throw InputError(path + ": not UTF-8 text (byte " + std::to_string(bad) +
                      "): a scene file is JSON");
   return parse_scene_json(bytes, path, config);

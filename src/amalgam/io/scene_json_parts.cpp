@@ -257,6 +257,24 @@ ScatterPattern read_scatter(const JsonReader& r, const JsonValue& v) {
   return {count, radius, seed, centre, rotate};
 }
 
+std::string beyond_limit(double bytes, const SceneFileConfig& config) {
+  if (config.max_bytes == 0 || bytes <= static_cast<double>(config.max_bytes)) return {};
+  return format_bytes(bytes) + ", more than " + config.limit_name;
+}
+
+/// The offset of the first byte that is not part of well-formed UTF-8 (or a NUL), or npos.
+std::size_t first_invalid_utf8(const std::string& s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    int n = c < 0x80 ? 0 : (c >> 5) == 0x6 ? 1 : (c >> 4) == 0xe ? 2 : (c >> 3) == 0x1e ? 3 : -1;
+    if (c == 0 || n < 0 || i + static_cast<std::size_t>(n) >= s.size()) return i;
+    for (int k = 1; k <= n; ++k)
+      if ((static_cast<unsigned char>(s[i + static_cast<std::size_t>(k)]) >> 6) != 0x2) return i;
+    i += static_cast<std::size_t>(n) + 1;
+  }
+  return std::string::npos;
+}
+
 }  // namespace amalgam::scene_json
 
 namespace amalgam {

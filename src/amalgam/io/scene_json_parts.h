@@ -16,6 +16,10 @@
 #include "amalgam/scene/description.h"
 #include "amalgam/scene/instance_patterns.h"
 
+namespace amalgam {
+struct SceneFileConfig;
+}  // namespace amalgam
+
 namespace amalgam::scene_json {
 
 /// An instance grid, {"nx", "nz", "spacing", "origin"?}: at most 10^8 instances.
@@ -81,5 +85,13 @@ std::vector<T> take_tail(std::vector<T>& v, std::size_t before, bool keep) {
 /// Appends the materials of `mesh` to `out.materials`, and its textures to `out.textures`
 /// (the materials' texture indices shifted to match). Returns the index of the first.
 std::uint32_t append_materials(SceneDescription& out, const ImportedMesh& mesh);
+
+/// "<bytes>, more than <limit>" when `bytes` pass config.max_bytes, else "" (a limit of 0 is
+/// none).
+std::string beyond_limit(double bytes, const SceneFileConfig& config);
+
+/// The offset of the first byte of `s` that is not part of well-formed UTF-8 (or a NUL), or
+/// npos.
+std::size_t first_invalid_utf8(const std::string& s);
 
 }  // namespace amalgam::scene_json
