@@ -141,7 +141,7 @@ void prepare(CommonOptions& common, const RenderExtras& extra, const std::string
   p.fp = fingerprint(common, *p.loaded);
   if (extra.resume && root) {
     if (!std::filesystem::exists(ckpt)) throw InputError(ckpt + ": no checkpoint to resume from");
-    p.state = read_checkpoint(ckpt, p.fp);
+    p.state = read_checkpoint(ckpt, p.fp, {o.width, o.height});
     if (p.state.spp_done > o.spp)
       throw InputError(ckpt + ": checkpoint holds " + std::to_string(p.state.spp_done) +
                        " samples per pixel, more than --spp " + std::to_string(o.spp));

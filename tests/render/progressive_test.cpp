@@ -135,5 +135,28 @@ TEST(Progressive, ACheckpointHeaderSaysWhatIsWrongWithIt) {
   std::filesystem::remove(path);
 }
 
+// A checkpoint whose header declares another film than the render's is refused from its
+// header, before its body (as large as the film it declares) is read.
+TEST(Progressive, ACheckpointOfAnotherFilmIsRefusedFromItsHeader) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("amalgam-film-" + std::to_string(getpid())))
+          .string();
+  FilmState st;
+  st.width = 500, st.height = 400, st.spp_done = 1;
+  st.sum.assign(200000, Vec3{0.5f, 0.5f, 0.5f});
+  st.tests.assign(200000, 7);
+  st.aov.assign(200000, PixelAov{});
+  write_checkpoint(path, "fp", st);
+  EXPECT_EQ(read_checkpoint(path, "fp", {500, 400}).width, 500);
+  std::string m;
+  try {
+    read_checkpoint(path, "fp", {2, 1});
+  } catch (const InputError& e) {
+    m = e.what();
+  }
+  EXPECT_NE(m.find("declares a 500x400 film, this render's is 2x1"), std::string::npos) << m;
+  std::filesystem::remove(path);
+}
+
 }  // namespace
 }  // namespace amalgam

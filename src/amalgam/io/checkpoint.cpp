@@ -114,7 +114,31 @@ bool is_checkpoint_of(const std::string& path, const std::string& fingerprint) {
   return head == expect;
 }
 
-FilmState read_checkpoint(const std::string& path, const std::string& fingerprint) {
+namespace {
+
+/// Throws the InputError for a file whose first bytes, `head`, are not this format's magic.
+[[noreturn]] void refuse_magic(const std::string& path, const std::string& head) {
+  if (head.compare(0, sizeof kMagicPrefix - 1, kMagicPrefix) != 0)
+    throw InputError(path + ": not an amalgam checkpoint");
+  // "AMALGAM-CHECKPOINT-<digits>\0" is a checkpoint of another format; anything else there
+  // (a flipped byte) is damage, whatever digits it starts with.
+  std::size_t i = sizeof kMagicPrefix - 1;
+  std::string format;
+  while (i < head.size() && format.size() < 4 && std::isdigit(static_cast<unsigned char>(head[i])))
+    format += head[i++];
+  if (format.empty() || format == kMagic + sizeof kMagicPrefix - 1 || i >= head.size() ||
+      head[i] != '\0')
+    throw InputError(path +
+                     ": checkpoint is damaged (its header is not that of any format): "
+                     "delete it to start over");
+  throw InputError(path + ": checkpoint of another amalgam version (format " + format +
+                   ", this one reads format 5): delete it and render again");
+}
+
+}  // namespace
+
+FilmState read_checkpoint(const std::string& path, const std::string& fingerprint,
+                          FilmSize film_size) {
   // Opened without waiting (a FIFO would wait for a writer) and refused unless a regular file:
   // a device or a FIFO may never end, and only a file has a size to check the header against.
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
@@ -146,27 +170,10 @@ FilmState read_checkpoint(const std::string& path, const std::string& fingerprin
   // The header: the magic with the format version, then the fingerprint's length.
   char magic[sizeof kMagic] = {};
   const bool whole_magic = read_at(0, magic, sizeof magic);
-  if (!whole_magic || std::memcmp(magic, kMagic, sizeof kMagic) != 0) {
-    const std::size_t got =
-        whole_magic ? sizeof magic : std::min<std::uint64_t>(size, sizeof magic);
-    const std::string head(magic, got);
-    if (head.compare(0, sizeof kMagicPrefix - 1, kMagicPrefix) != 0)
-      throw InputError(path + ": not an amalgam checkpoint");
-    // "AMALGAM-CHECKPOINT-<digits>\0" is a checkpoint of another format; anything else there
-    // (a flipped byte) is damage, whatever digits it starts with.
-    std::size_t i = sizeof kMagicPrefix - 1;
-    std::string format;
-    while (i < head.size() && format.size() < 4 &&
-           std::isdigit(static_cast<unsigned char>(head[i])))
-      format += head[i++];
-    if (format.empty() || format == kMagic + sizeof kMagicPrefix - 1 || i >= head.size() ||
-        head[i] != '\0')
-      throw InputError(path +
-                       ": checkpoint is damaged (its header is not that of any format): "
-                       "delete it to start over");
-    throw InputError(path + ": checkpoint of another amalgam version (format " + format +
-                     ", this one reads format 5): delete it and render again");
-  }
+  if (!whole_magic || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
+    refuse_magic(
+        path, std::string(
+                  magic, whole_magic ? sizeof magic : std::min<std::uint64_t>(size, sizeof magic)));
   // Every size the header declares is checked against the file's before it is read, so no more
   // than the checkpoint's own bytes (the film of this render, checked by the fingerprint) are
   // ever held.
@@ -176,11 +183,22 @@ FilmState read_checkpoint(const std::string& path, const std::string& fingerprin
   std::uint64_t fp_size = 0;
   if (!read_at(sizeof kMagic, &fp_size, sizeof fp_size)) throw InputError(short_file);
   if (fp_size > (1u << 20)) throw InputError(path + ": corrupt checkpoint header");
+  // The settings and the film the header declares are this render's, before the body is read.
+  std::string fp(static_cast<std::size_t>(fp_size), '\0');
+  if (!read_at(sizeof kMagic + sizeof fp_size, fp.data(), fp.size())) throw InputError(short_file);
+  if (fp != fingerprint)
+    throw InputError(path + ": checkpoint was written for different settings (" +
+                     one_line(fp, 300) + ")");
   const std::uint64_t dims_at = sizeof kMagic + sizeof fp_size + fp_size;
   int dims[3] = {};
   if (!read_at(dims_at, dims, sizeof dims)) throw InputError(short_file);
   if (dims[0] < 1 || dims[1] < 1 || static_cast<std::uint64_t>(dims[0]) * dims[1] > (1ull << 32))
     throw InputError(path + ": corrupt checkpoint header");
+  if (film_size.width > 0 && (dims[0] != film_size.width || dims[1] != film_size.height))
+    throw InputError(path + ": checkpoint declares a " + std::to_string(dims[0]) + "x" +
+                     std::to_string(dims[1]) + " film, this render's is " +
+                     std::to_string(film_size.width) + "x" + std::to_string(film_size.height) +
+                     ": it is damaged; delete it to start over");
   const std::uint64_t film = static_cast<std::uint64_t>(dims[0]) * dims[1];
   const std::uint64_t distinct_at =
       dims_at + sizeof dims + film * (sizeof(Vec3) + sizeof(std::uint64_t) + sizeof(PixelAov)) +
@@ -207,10 +225,7 @@ FilmState read_checkpoint(const std::string& path, const std::string& fingerprin
   std::uint64_t len = 0;
   get(in, len);
   if (!in || len > (1u << 20)) throw InputError(path + ": corrupt checkpoint header");
-  std::string fp(len, '\0');
-  in.read(fp.data(), static_cast<std::streamsize>(len));
-  if (fp != fingerprint)
-    throw InputError(path + ": checkpoint was written for different settings (" + fp + ")");
+  in.seekg(static_cast<std::streamoff>(len), std::ios::cur);  // checked above
   FilmState st;
   get(in, st.width);
   get(in, st.height);

@@ -15,9 +15,16 @@ namespace amalgam {
 void write_checkpoint(const std::string& path, const std::string& fingerprint,
                       const FilmState& state);
 
+/// The film a checkpoint must hold (a width of 0: any).
+struct FilmSize {
+  int width = 0, height = 0;
+};
+
 /// Reads a checkpoint; throws InputError naming the file when it is unreadable, corrupt, or
-/// was written for a different fingerprint.
-FilmState read_checkpoint(const std::string& path, const std::string& fingerprint);
+/// was written for a different fingerprint or film. The header is checked against both before
+/// the body is read: no more than this render's film is ever held.
+FilmState read_checkpoint(const std::string& path, const std::string& fingerprint,
+                          FilmSize film = {});
 
 /// True when `path` is a regular file that begins as a checkpoint written for `fingerprint`
 /// (its magic and fingerprint; the rest is not read). False on any error: what a completed
