@@ -255,6 +255,8 @@ TEST(BadInput, DeclaredSizesAndIndicesTheFileCannotHoldAreRefused) {
                  R"("accessors":[{"bufferView":0,"byteOffset":1.5,"componentType":5126,)"
                  R"("count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}]})");
   write_file(d / "index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n");
+  write_file(d / "negative.off", "OFF 3 1 0\n# a comment\n0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n");
+  write_file(d / "fraction.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n\n3 0 1.5 2\n");
   write_file(d / "list.ply",
              "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
              "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
@@ -268,7 +270,15 @@ TEST(BadInput, DeclaredSizesAndIndicesTheFileCannotHoldAreRefused) {
        "(22 bytes)"},
       {"view.gltf", "bufferViews/0/byteOffset is -100, not a non-negative integer"},
       {"accessor.gltf", "accessors/0/byteOffset is 1.5, not a non-negative integer"},
-      {"index.off", "corrupt data: OFF: Vertex index is out of range"},
+      {"index.off",
+       "face 0 has vertex index '9': expected a whole number below 3, the vertices the header "
+       "declares"},
+      {"negative.off",
+       "face 0 has vertex index '-1': expected a whole number below 3, the vertices the header "
+       "declares"},
+      {"fraction.off",
+       "face 0 has vertex index '1.5': expected a whole number below 3, the vertices the header "
+       "declares"},
       {"list.ply",
        "corrupt data: Unable to parse property instance. Skipping this element instance"},
   };

@@ -14,6 +14,42 @@
 
 namespace amalgam {
 
+namespace {
+
+/// The lines of `in` that hold something (not blank, not a # comment).
+bool next_content_line(std::istream& in, std::string& line) {
+  while (std::getline(in, line)) {
+    const std::size_t at = line.find_first_not_of(" \t\r");
+    if (at != std::string::npos && line[at] != '#') return true;
+  }
+  return false;
+}
+
+/// An OFF body's face indices are vertex numbers: whole numbers below `nv` (Assimp 5.2 reads
+/// -1 or 1.5 as some vertex and renders the file).
+void check_off_faces(const std::string& path, std::istream& in, std::uint64_t nv,
+                     std::uint64_t nf) {
+  std::string line;
+  std::getline(in, line);  // the rest of the counts' line
+  for (std::uint64_t v = 0; v < nv; ++v)
+    if (!next_content_line(in, line)) return;  // short files are Assimp's to refuse
+  for (std::uint64_t f = 0; f < nf && next_content_line(in, line); ++f) {
+    std::istringstream words(line);
+    std::uint64_t k = 0;
+    if (!(words >> k)) return;
+    std::string index;
+    for (std::uint64_t i = 0; i < k && words >> index; ++i) {
+      const bool digits = index.find_first_not_of("0123456789") == std::string::npos;
+      if (!digits || index.size() > 19 || std::stoull(index) >= nv)
+        fail_input(path, "face " + std::to_string(f) + " has vertex index '" + index.substr(0, 24) +
+                             "': expected a whole number below " + std::to_string(nv) +
+                             ", the vertices the header declares");
+    }
+  }
+}
+
+}  // namespace
+
 void check_mesh_file(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -44,12 +80,12 @@ void check_mesh_file(const std::string& path) {
     // "OFF" (possibly with prefixes such as C, N, ST) then "nv nf ne", possibly on one line.
     std::string word;
     if (!(in >> word) || word.find("OFF") == std::string::npos) return;
-    std::string rest = word.substr(word.find("OFF") + 3);
     double nv = 0, nf = 0;
-    std::istringstream counts(rest);
+    std::istringstream counts(word.substr(word.find("OFF") + 3));
     if (!(counts >> nv >> nf) && !(in >> nv >> nf)) return;
     too_many(nv, "vertices");
     too_many(nf, "faces");
+    check_off_faces(path, in, static_cast<std::uint64_t>(nv), static_cast<std::uint64_t>(nf));
   } else {
     // The header grammar is checked: Assimp 5.2 crashes on some malformed headers (reads
     // past a header without end_header; asserts in its triangulation on faces read through a

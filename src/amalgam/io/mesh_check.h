@@ -11,6 +11,7 @@ namespace amalgam {
 /// wrongly, or only after allocating without bound:
 /// - OFF and PLY element counts that the file's size cannot possibly hold (the testmodels'
 ///   invalid/OutOfMemory.off declares 3.5e11 vertices and takes a minute to fail);
+/// - OFF face indices that are not whole numbers below the vertex count (-1, 1.5);
 /// - a PLY header (by extension or by content) whose grammar is broken: Assimp 5.2 crashes on
 ///   some (found by fuzz/mesh_fuzz.cpp; tests/fuzz_regressions_test.cpp);
 /// - a binary glTF (`.glb`, or any file starting with `glTF`) whose header or chunks declare
