@@ -201,6 +201,10 @@ std::shared_ptr<Scene> load(const std::string& spec, const py::kwargs& params) {
   {
     py::gil_scoped_release nogil;
     LoadedScene loaded = load_scene(spec, p, config);
+    if (config.objects && !loaded.volumes)  // the CLI refuses it when it renders
+      throw InputError("volumetric=True: " + spec +
+                       " has no meshes, which are what the volumetric renderer prefilters into "
+                       "cells (spheres, boxes, loose triangles and builtin scenes have none)");
     choose_camera(loaded, view);
     s->scene = std::make_shared<const LoadedScene>(std::move(loaded));
   }
@@ -253,6 +257,9 @@ py::dict compare(const py::object& a, const py::object& b) {
                      std::to_string(wb) + "x" + std::to_string(hb) +
                      ": compare needs images of the same size");
   if (wa == 0 || ha == 0) throw InputError("a: the image is empty");
+  for (const auto& [name, image] : {std::pair{"a", &pa}, std::pair{"b", &pb}})
+    if (const std::string why = non_finite_pixels(*image); !why.empty())
+      throw InputError(std::string(name) + ": " + why);
   ImageComparison c;
   {
     py::gil_scoped_release nogil;

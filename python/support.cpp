@@ -6,6 +6,7 @@
 
 #include "amalgam/render/option_rules.h"
 #include "amalgam/render/tracer.h"
+#include "amalgam/scene/coordinate_limit.h"
 #include "amalgam/util/error.h"
 
 namespace amalgam::python {
@@ -90,6 +91,11 @@ Vec3 view_vec(const py::handle& v, const std::string& option) {
   if (x.size() != 3 || !is_finite(Vec3{x[0], x[1], x[2]}))
     throw InputError(option_text(option, OptionSpelling::kKeywords, "'" + text + "'") +
                      ": expected three numbers x,y,z");
+  for (const float c : x)  // the CLI's range (scene/coordinate_limit.h)
+    if (std::abs(static_cast<double>(c)) > kMaxCoordinate)
+      throw InputError(option_text(option, OptionSpelling::kKeywords, "'" + text + "'") +
+                       ": each coordinate must be within [-1e12, 1e12], the range of scene "
+                       "coordinates");
   return {x[0], x[1], x[2]};
 }
 

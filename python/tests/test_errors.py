@@ -159,3 +159,24 @@ def test_bad_view_keywords_are_value_errors(cli, tmp_path):
         scene.render(width=4, height=4, spp=1, up=(0, 0, 1), eye=(0, 0, 3), look_at=(0, 0, 0))
     with pytest.raises(ValueError, match="^eye=/look_at=: the eye is at the look-at point"):
         scene.render(width=4, height=4, spp=1, eye=(1, 1, 1), look_at=(1, 1, 1))
+
+
+def test_python_refuses_what_the_cli_refuses(cli, tmp_path):
+    # Non-finite images: NaN compares false with everything, so an all-NaN pair came out as
+    # SSIM 1 and max error 0; refused as by `amalgam compare`.
+    nan = np.full((4, 4, 3), np.nan, dtype=np.float32)
+    with pytest.raises(ValueError, match="^a: 16 of 16 pixels are not finite"):
+        amalgam.compare(nan, nan)
+    good = np.zeros((4, 4, 3), dtype=np.float32)
+    with pytest.raises(ValueError, match="^b: 16 of 16 pixels are not finite"):
+        amalgam.compare(good, nan)
+    # A view vector beyond the range of scene coordinates, with the CLI's words.
+    message, status = cli_message(cli, "render", "builtin:demo", "--eye", "1e13,0,0", "--out",
+                                  str(tmp_path / "x.pfm"))
+    assert status == 2 and "must be within [-1e12, 1e12]" in message
+    with pytest.raises(ValueError, match=r"^eye='.*': each coordinate must be within \[-1e12"):
+        amalgam.load("builtin:demo", eye=(1e13, 0, 0))
+    # volumetric=True on a scene without meshes (a builtin): refused when loading, as the CLI
+    # refuses --renderer volumetric on it.
+    with pytest.raises(ValueError, match="^volumetric=True: builtin:demo has no meshes"):
+        amalgam.load("builtin:demo", volumetric=True)

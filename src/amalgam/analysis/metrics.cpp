@@ -157,6 +157,15 @@ std::vector<double> error_map(const std::vector<Vec3>& a, const std::vector<Vec3
   return e;
 }
 
+std::string non_finite_pixels(const std::vector<Vec3>& image) {
+  std::size_t bad = 0;
+  for (const Vec3& p : image)
+    bad += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+  if (bad == 0) return {};
+  return std::to_string(bad) + " of " + std::to_string(image.size()) +
+         " pixels are not finite (NaN or infinity): compare needs finite values";
+}
+
 ImageComparison compare_images(const std::vector<Vec3>& a, const std::vector<Vec3>& b, int width,
                                int height, const SsimConfig& config) {
   check_dims(a, b, width, height);

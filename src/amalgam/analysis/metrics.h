@@ -4,6 +4,7 @@
 /// write_image (pixel (x, y) at index y * width + x). No I/O.
 
 #include <array>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -76,6 +77,11 @@ struct ImageComparison {
              {"rel_mse", rel_mse}}};
   }
 };
+
+/// "N of M pixels are not finite (NaN or infinity): compare needs finite values" when some of
+/// `image`'s are not finite, else "" (NaN compares false with everything: an all-NaN pair
+/// would come out as SSIM 1 and max error 0).
+std::string non_finite_pixels(const std::vector<Vec3>& image);
 
 /// All the metrics above for two width x height images. Throws MetricsError if either
 /// pixel count differs from width * height.
