@@ -187,14 +187,8 @@ void check_advise_outputs(const AdviseOptions& a, const CommonOptions& common) {
                      " films held at once need " + format_bytes(bytes) +
                      ", more than this machine's memory");
   check_files({{"--out", a.out}, {"--json", a.json}}, common.scene);
-  if (!a.keep.empty()) {
-    std::error_code ec;
-    if (std::filesystem::exists(a.keep, ec) && !std::filesystem::is_directory(a.keep, ec))
-      throw InputError("--keep " + a.keep + ": exists and is not a directory");
-    std::filesystem::create_directories(a.keep, ec);
-    if (ec) throw InputError("--keep " + a.keep + ": cannot create the directory: " + ec.message());
-    check_files(advise_outputs(a, common.options), common.scene);
-  }
+  if (!a.keep.empty())
+    make_output_dir("--keep", a.keep, advise_outputs(a, common.options), common.scene);
 }
 
 /// Each candidate rendered for `budget` seconds of rendering, its RMSE against `ref`, and

@@ -17,6 +17,7 @@
 #include "amalgam/io/legend.h"
 #include "amalgam/util/atomic_file.h"
 #include "common.h"
+#include "render_setup.h"
 
 namespace amalgam::cli {
 namespace {
@@ -41,30 +42,26 @@ std::string format_number(double v) {
 }  // namespace
 
 int run_compare(const CompareOptions& o) {
-  if (!o.error_image.empty()) {
-    check_writable(o.error_image);
-    const std::string out = file_identity(o.error_image);
-    for (const std::string* in : {&o.a, &o.b})
-      if (!out.empty() && std::filesystem::exists(*in) && out == file_identity(*in))
-        throw InputError("--error-image " + o.error_image + ": the input " + *in +
-                         " itself (an output never replaces an input)");
+  if (!o.error_image.empty()) {  // the one output check of every subcommand, before any work
+    if (!is_image_path(o.error_image))
+      throw InputError("--error-image " + o.error_image +
+                       ": unsupported image format (expected .png, .exr or .pfm)");
+    for (const std::string* in : {&o.a, &o.b}) check_files({{"--error-image", o.error_image}}, *in);
   }
   int wa = 0, ha = 0, wb = 0, hb = 0;
+  const auto same_size = [&] {
+    if (wa != wb || ha != hb)
+      throw InputError(o.a + " is " + std::to_string(wa) + "x" + std::to_string(ha) + " but " +
+                       o.b + " is " + std::to_string(wb) + "x" + std::to_string(hb) +
+                       ": compare needs images of the same size");
+  };
+  if (image_size(o.a, wa, ha) && image_size(o.b, wb, hb)) same_size();  // before decoding
   const std::vector<Vec3> a = read_input(o.a, wa, ha);
   const std::vector<Vec3> b = read_input(o.b, wb, hb);
-  if (wa != wb || ha != hb)
-    throw InputError(o.a + " is " + std::to_string(wa) + "x" + std::to_string(ha) + " but " + o.b +
-                     " is " + std::to_string(wb) + "x" + std::to_string(hb) +
-                     ": compare needs images of the same size");
-  // NaN compares false with everything: an all-NaN pair came out as SSIM 1 and max error 0.
-  for (const auto& [path, image] : {std::pair{&o.a, &a}, std::pair{&o.b, &b}}) {
-    std::size_t bad = 0;
-    for (const Vec3& p : *image)
-      bad += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
-    if (bad > 0)
-      throw InputError(*path + ": " + std::to_string(bad) + " of " + std::to_string(image->size()) +
-                       " pixels are not finite (NaN or infinity): compare needs finite values");
-  }
+  same_size();
+  for (const auto& [path, image] : {std::pair{&o.a, &a}, std::pair{&o.b, &b}})
+    if (const std::string why = non_finite_pixels(*image); !why.empty())
+      throw InputError(*path + ": " + why);
   const ImageComparison c = compare_images(a, b, wa, ha);
 
   double vmax = 0;

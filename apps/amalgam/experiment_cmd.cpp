@@ -15,6 +15,7 @@
 #include "amalgam/load/load_scene.h"
 #include "amalgam/util/atomic_file.h"
 #include "common.h"
+#include "render_setup.h"
 #if defined(AMALGAM_HAVE_MPI)
 #include "mpi_render.h"
 #endif
@@ -415,16 +416,17 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
 #else
   const bool root = true;
 #endif
+  const ex::Config config = make_config(quick, threads, scenes_dir);  // refusals before --out
   bool gnuplot = false;
   // Under mpirun only rank 0 writes; a failure of its directory must stop every rank.
   std::exception_ptr failure;
   try {
     if (root) {
-      std::error_code ec;
-      fs::create_directories(dir, ec);
-      if (ec || !fs::is_directory(dir))
-        throw InputError("--out " + out_dir + ": cannot create the directory (" + ec.message() +
-                         ")");
+      std::vector<OutputFile> outs = {{"--out", (dir / "report.md").string()}};
+      for (const std::string& n : todo)
+        for (const char* ext : {".csv", ".gp", ".png"})
+          outs.push_back({"--out", (dir / (n + ext)).string()});
+      make_output_dir("--out", out_dir, outs, "");
       gnuplot = have_gnuplot();
       if (!gnuplot)
         std::cerr << "amalgam: gnuplot is not on PATH; writing CSVs and the report only\n";
@@ -443,7 +445,6 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
     gnuplot = mpi::broadcast(gnuplot ? "1" : "0") == "1";  // the report says rank 0's
   }
 #endif
-  const ex::Config config = make_config(quick, threads, scenes_dir);
   Report rep;
   rep.dir = dir, rep.gnuplot = gnuplot;
   rep.summary << "| experiment | verdict | checks passed | seconds |\n|---|---|---|---|\n";

@@ -1,8 +1,10 @@
 /// The `amalgam` command line: render, trace, scenes, experiment, compare, advise (docs/cli.md).
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <iostream>
 #include <new>
@@ -209,6 +211,30 @@ std::optional<int> parse(CLI::App& app, int argc, char** argv) {
   return std::nullopt;
 }
 
+/// Standard output's write errors (a full disk, /dev/full) fail the command that printed
+/// there: its output is flushed and checked before the status is returned.
+int checked_stdout(int status) {
+  errno = 0;
+  std::cout.flush();
+  if (std::cout && std::fflush(stdout) == 0) return status;
+  const int err = errno;
+  std::cerr << "amalgam: cannot write to standard output"
+            << (err != 0 ? std::string(": ") + std::strerror(err) : std::string()) << "\n";
+  return status == 0 ? 1 : status;
+}
+
+int run(Commands& c) {
+  namespace cli = amalgam::cli;
+  if (c.render->parsed()) return cli::run_render(c.render_opts, c.extras);
+  if (c.trace->parsed()) return cli::run_trace(c.trace_opts, c.origin, c.direction);
+  if (c.experiment->parsed())
+    return cli::run_experiment(c.exp_name, c.exp_out, c.exp_quick, c.exp_threads, c.exp_scenes,
+                               c.exp_partial);
+  if (c.compare->parsed()) return cli::run_compare(c.cmp);
+  if (c.advise->parsed()) return cli::run_advise(c.advise_opts, c.adv);
+  return cli::run_scenes();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -229,18 +255,11 @@ int main(int argc, char** argv) {
   add_experiment(app, c);
   add_compare(app, c);
   add_advise(app, c);
-  if (const std::optional<int> status = parse(app, argc, argv)) return *status;
+  if (const std::optional<int> status = parse(app, argc, argv)) return checked_stdout(*status);
 
   c.extras.max_memory_given = c.max_memory->count() > 0;  // an empty value is given, and refused
   try {
-    if (c.render->parsed()) return cli::run_render(c.render_opts, c.extras);
-    if (c.trace->parsed()) return cli::run_trace(c.trace_opts, c.origin, c.direction);
-    if (c.experiment->parsed())
-      return cli::run_experiment(c.exp_name, c.exp_out, c.exp_quick, c.exp_threads, c.exp_scenes,
-                                 c.exp_partial);
-    if (c.compare->parsed()) return cli::run_compare(c.cmp);
-    if (c.advise->parsed()) return cli::run_advise(c.advise_opts, c.adv);
-    return cli::run_scenes();
+    return checked_stdout(run(c));
   } catch (const std::bad_alloc&) {
     std::cerr << "amalgam: out of memory while " << cli::activity() << "\n";
     return 1;

@@ -151,7 +151,10 @@ void prepare(CommonOptions& common, const RenderExtras& extra, const std::string
 /// SIGHUP (a closed terminal, a dropped SSH session) and SIGQUIT stop the render as SIGINT and
 /// SIGTERM do. A signal ignored at start stays ignored: nohup ignores SIGHUP, and a shell
 /// ignores SIGINT and SIGQUIT in the background jobs it starts, so they outlive a Ctrl-C.
+/// SIGPIPE is ignored: a FIFO or pipe whose reader went away fails that one write (EPIPE), as
+/// a full disk does, instead of ending the render without its other outputs.
 void catch_stop_signals() {
+  std::signal(SIGPIPE, SIG_IGN);
   struct sigaction sa {};
   sa.sa_handler = on_signal;
   sigemptyset(&sa.sa_mask);

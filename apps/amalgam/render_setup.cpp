@@ -50,6 +50,18 @@ std::string fingerprint(const CommonOptions& c, const LoadedScene& scene) {
   return f.str();
 }
 
+void make_output_dir(const std::string& option, const std::string& dir,
+                     const std::vector<OutputFile>& outs, const std::string& scene) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw InputError(option + " " + dir + ": exists and is not a directory");
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir, ec))
+    throw InputError(option + " " + dir + ": cannot create the directory: " + ec.message());
+  check_files(outs, scene);
+}
+
 void check_outputs_spare_inputs(const RenderExtras& e, const std::string& ckpt,
                                 const LoadedScene& scene) {
   check_files_spare_inputs(outputs(e, ckpt), scene);
@@ -145,7 +157,7 @@ std::string command_text(const std::vector<std::string>& argv) {
       ++i;  // and its value
       continue;
     }
-    if (a.starts_with("--threads=")) continue;
+    if (a.starts_with("--threads=") || a == "--resume") continue;  // same image either way
     if (!out.empty()) out += ' ';
     const bool plain = !a.empty() && a.find_first_not_of(
                                          "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMN"

@@ -29,6 +29,12 @@ struct OutputFile {
 /// a new file). Throws InputError.
 void check_files(const std::vector<OutputFile>& outs, const std::string& scene);
 
+/// Creates the directory `dir` that `option` names (the caller's other checks come first, so
+/// that a refused command leaves no directory behind) and checks `outs`, the files to be written
+/// there, with check_files. Throws InputError.
+void make_output_dir(const std::string& option, const std::string& dir,
+                     const std::vector<OutputFile>& outs, const std::string& scene);
+
 /// Once the scene is loaded, before anything is written: no output on a file it read (the
 /// meshes a scene file names and every file their import read). Throws InputError.
 void check_files_spare_inputs(const std::vector<OutputFile>& outs, const LoadedScene& scene);
@@ -57,8 +63,9 @@ std::uint64_t film_bytes(const RenderOptions& o);
 LogRange parse_cost_range(const std::string& text);
 
 /// The command line as one string, each argument that needs it in single quotes, without
-/// --threads: it goes into the EXR header, which is part of the file's bytes, and those are the
-/// same for any thread count (the stats hold the threads used).
+/// --threads and --resume: it goes into the EXR header, which is part of the file's bytes, and
+/// those are the same for any thread count (the stats hold the threads used) and whether the
+/// render was resumed or not.
 std::string command_text(const std::vector<std::string>& argv);
 
 /// The renderer options as command-line text (the EXR header's "amalgam:options").

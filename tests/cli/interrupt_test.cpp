@@ -148,6 +148,25 @@ TEST(CliInterrupt, SigintWritesTheCompletePartialImageAndResumeMatchesAnUninterr
   EXPECT_FALSE(fs::exists(out + ".ckpt")) << "checkpoint removed once complete";
 }
 
+// A resumed OpenEXR is the same file as the uninterrupted render's, header included: the
+// command line it records leaves out --resume (it used to record it; the pixels were the same).
+TEST(CliInterrupt, AResumedExrIsTheSameFileAsAnUninterruptedOne) {
+  Dir d("exr");
+  const std::string out = (d.path / "run.exr").string();
+  EXPECT_EQ(interrupt(d, out, {SIGINT}), 1);
+  const int held = samples_held(slurp(d.path / "err.txt"));
+  ASSERT_GE(held, 1) << slurp(d.path / "err.txt");
+  // The uninterrupted render under the same command line (the path is in the header), its
+  // checkpoint set aside meanwhile.
+  const std::string spp = " --spp " + std::to_string(held + 1);
+  fs::rename(out + ".ckpt", d.path / "kept.ckpt");
+  ASSERT_EQ(run(kRender + spp + " --out " + out), 0);
+  const std::string ref = slurp(out);
+  fs::rename(d.path / "kept.ckpt", out + ".ckpt");
+  ASSERT_EQ(run(kRender + spp + " --out " + out + " --resume"), 0);
+  EXPECT_TRUE(slurp(out) == ref) << "the resumed EXR differs";
+}
+
 TEST(CliInterrupt, SigtermDoesTheSame) {
   Dir d("sigterm");
   const std::string out = (d.path / "run.pfm").string();

@@ -123,6 +123,23 @@ std::vector<Vec3> read_exr_rgba(const std::string& path, int& width, int& height
 
 }  // namespace
 
+bool exr_size(const std::string& path, int& width, int& height) {
+  std::ifstream is(path, std::ios::binary);
+  if (!is) return false;
+  try {
+    Imf::StdIFStream stream(is, path.c_str());
+    const Imf::InputFile file(stream);
+    const Imath::Box2i dw = file.header().dataWindow();
+    const std::int64_t w = static_cast<std::int64_t>(dw.max.x) - dw.min.x + 1;
+    const std::int64_t h = static_cast<std::int64_t>(dw.max.y) - dw.min.y + 1;
+    if (w <= 0 || h <= 0 || w > 0x7fffffff || h > 0x7fffffff) return false;
+    width = static_cast<int>(w), height = static_cast<int>(h);
+    return true;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
 std::vector<Vec3> read_exr(const std::string& path, int& width, int& height) {
   std::ifstream is(path, std::ios::binary);
   if (!is) throw Failure("cannot open for reading: " + errno_text(errno));

@@ -35,5 +35,7 @@ void write_exr(AtomicFile& out, int width, int height, const std::vector<Vec3>& 
 /// other channels, e.g. the layers of `render --out x.exr`, are ignored), any data window. A
 /// file without R, G and B (e.g. luminance only) is read through OpenEXR's RGBA interface.
 std::vector<Vec3> read_exr(const std::string& path, int& width, int& height);
+/// The size of an OpenEXR file's data window, from its header alone; false if unreadable.
+bool exr_size(const std::string& path, int& width, int& height);
 
 }  // namespace amalgam::codec

@@ -2,8 +2,12 @@
 
 #include <cctype>
 #include <cstddef>
+#include <cstring>
 #include <exception>
 #include <filesystem>
+#include <fstream>
+#include <new>
+#include <sstream>
 
 #include "amalgam/io/exr.h"
 #include "amalgam/io/pfm.h"
@@ -71,10 +75,48 @@ std::vector<Vec3> read_image(const std::string& path, int& width, int& height) {
       case Format::kExr:
         return codec::read_exr(path, width, height);
     }
+  } catch (const std::bad_alloc&) {
+    throw ImageIoError(path + ": not enough memory to decode it");
   } catch (const std::exception& e) {
     throw ImageIoError(path + ": " + one_line(e.what(), std::string::npos));
   }
   throw ImageIoError(path + ": unknown image format");
+}
+
+bool image_size(const std::string& path, int& width, int& height) {
+  try {
+    const Format format = image_format(path);
+    if (format == Format::kExr) return codec::exr_size(path, width, height);
+    std::ifstream in(path, std::ios::binary);
+    unsigned char head[64] = {};
+    in.read(reinterpret_cast<char*>(head), sizeof head);
+    const std::size_t n = static_cast<std::size_t>(in.gcount());
+    if (format == Format::kPng) {
+      // The signature, then the IHDR chunk: its length, "IHDR", width and height big-endian.
+      static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+      if (n < 24 || std::memcmp(head, kSignature, 8) != 0 || std::memcmp(head + 12, "IHDR", 4))
+        return false;
+      const auto be32 = [&](int at) {
+        return std::uint32_t{head[at]} << 24 | std::uint32_t{head[at + 1]} << 16 |
+               std::uint32_t{head[at + 2]} << 8 | std::uint32_t{head[at + 3]};
+      };
+      if (be32(16) == 0 || be32(16) > 0x7fffffff || be32(20) == 0 || be32(20) > 0x7fffffff)
+        return false;
+      width = static_cast<int>(be32(16)), height = static_cast<int>(be32(20));
+      return true;
+    }
+    // PFM: "PF" or "Pf", then the width and height as text.
+    std::istringstream text(std::string(reinterpret_cast<const char*>(head), n));
+    std::string magic;
+    long long w = 0, h = 0;
+    if (!(text >> magic >> w >> h) || (magic != "PF" && magic != "Pf") || w <= 0 || h <= 0 ||
+        w > 0x7fffffff || h > 0x7fffffff)
+      return false;
+    width = static_cast<int>(w), height = static_cast<int>(h);
+    return true;
+  } catch (const std::exception&) {
+    return false;
+  }
 }
 
 }  // namespace amalgam

@@ -43,4 +43,8 @@ void write_image(const std::string& path, int width, int height,
 /// ImageIoError naming the file on any error.
 std::vector<Vec3> read_image(const std::string& path, int& width, int& height);
 
+/// The width and height an image's header declares, read without decoding its pixels; false
+/// when the header cannot be read (read_image then says why).
+bool image_size(const std::string& path, int& width, int& height);
+
 }  // namespace amalgam

@@ -38,10 +38,15 @@ void check_options(const LoadedScene& scene, const RenderOptions& o, OptionSpell
       throw InputError(option_text("--renderer", spelling, "volumetric") +
                        " composites its cells by coverage: " + option_text("--opacity", spelling) +
                        " does not apply");
-    if (!scene.volumes || !std::holds_alternative<InstancedHierarchy>(scene.hierarchy))
+    if (!std::holds_alternative<InstancedHierarchy>(scene.hierarchy))
+      throw InputError(option_text("--renderer", spelling, "volumetric") + ": " + scene.name +
+                       " has no meshes, which are what it prefilters into cells (spheres, boxes, "
+                       "loose triangles and builtin scenes have none): render it with another "
+                       "renderer");
+    if (!scene.volumes)
       throw InputError(option_text("--renderer", spelling, "volumetric") + ": " + scene.name +
                        " was loaded without volumetric amalgams (load it for the volumetric "
-                       "renderer; builtin scenes have none)");
+                       "renderer)");
   }
 }
 

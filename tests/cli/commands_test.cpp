@@ -1,0 +1,146 @@
+// What every subcommand owes its user beyond `render`'s outputs: standard output's write errors
+// are failures, a FIFO whose reader went away costs one checkpoint and not the render, compare
+// and experiment check their outputs before any work (and a refused experiment leaves nothing
+// behind), and the volumetric renderer's refusals say what is wrong.
+
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include "cli_support.h"
+
+namespace {
+namespace commands {  // per file: the tests are compiled in batches
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int status;
+  std::string err;
+};
+
+fs::path scratch() {
+  return amalgam::test::scratch_dir("amalgam-commands");
+}
+
+/// Runs amalgam with `args` under `timeout 20` (stdout as `args` redirects it, else discarded);
+/// its status and stderr.
+Result amalgam(const std::string& args) {
+  const fs::path err = scratch() / "stderr.txt";
+  const bool redirected = args.find(" >") != std::string::npos;
+  const auto r =
+      amalgam::test::run_command("timeout -k 1 20 " + std::string(AMALGAM_BINARY) + " " + args +
+                                 (redirected ? "" : " >/dev/null") + " 2>" + err.string());
+  return {r.status, amalgam::test::slurp(err)};
+}
+
+int lines(const std::string& text) {
+  int n = 0;
+  for (char c : text) n += c == '\n';
+  return n;
+}
+
+const std::string kSmall =
+    "render builtin:prisms --set depth=3 --width 8 --height 8 --spp 1 --quiet --out ";
+
+// A write error on standard output (a full disk: /dev/full) fails the command that printed
+// there, with one line: each of these exited 0 having printed nothing.
+TEST(Stdout, AWriteErrorOnStandardOutputIsAFailure) {
+  const std::string png = (scratch() / "a.png").string();
+  ASSERT_EQ(amalgam(kSmall + png).status, 0);
+  for (const std::string& cmd :
+       {std::string("--version"), std::string("scenes"), "compare " + png + " " + png,
+        std::string("trace builtin:prisms --set depth=3")}) {
+    const Result r = amalgam(cmd + " >/dev/full");
+    EXPECT_EQ(r.status, 1) << cmd << ": " << r.err;
+    EXPECT_NE(r.err.find("amalgam: cannot write to standard output"), std::string::npos)
+        << cmd << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1) << cmd << ": " << r.err;
+  }
+  EXPECT_EQ(amalgam("scenes").status, 0);
+}
+
+// A checkpoint FIFO whose reader leaves after 100 bytes: one warning, and the render goes on
+// and writes its image (SIGPIPE used to end it: no image, no stats).
+TEST(Stdout, AFifoWhoseReaderWentAwayCostsOnlyTheCheckpoint) {
+  const fs::path fifo = scratch() / "ckpt.fifo", png = scratch() / "fifo.png";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::thread reader([&] {
+    (void)amalgam::test::run_command("timeout 20 head -c 100 " + fifo.string() + " >/dev/null");
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the reader opens first
+  const Result r = amalgam(
+      "render builtin:prisms --set depth=6 --width 256 --height 256 --spp 4 --quiet "
+      "--checkpoint-every 0 --checkpoint " +
+      fifo.string() + " --out " + png.string());
+  reader.join();
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(png)) << r.err;
+  EXPECT_NE(r.err.find("warning: checkpoint " + fifo.string() + " not written"), std::string::npos)
+      << r.err;
+}
+
+// compare checks its output before any work, and reads the images' sizes from their headers
+// before decoding them.
+TEST(Compare, TheOutputAndTheSizesAreCheckedBeforeAnyWork) {
+  const std::string a = (scratch() / "c8.png").string(), b = (scratch() / "c16.png").string();
+  ASSERT_EQ(amalgam(kSmall + a).status, 0);
+  ASSERT_EQ(amalgam("render builtin:prisms --set depth=3 --width 16 --height 8 --spp 1 --quiet "
+                    "--out " +
+                    b)
+                .status,
+            0);
+  // An error image that is no image format: exit 2 at once (it used to be exit 1 after the
+  // comparison).
+  Result r = amalgam("compare " + a + " " + a + " --error-image " + (scratch() / "e.txt").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("--error-image"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("unsupported image format"), std::string::npos) << r.err;
+  // A first image whose pixels are damaged but whose header says 8x8: the sizes differ, said
+  // from the headers, before the damaged pixels are decoded.
+  std::string bytes = amalgam::test::slurp(a);
+  bytes.resize(40);
+  const std::string cut = (scratch() / "cut.png").string();
+  std::ofstream(cut, std::ios::binary) << bytes;
+  r = amalgam("compare " + cut + " " + b);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("is 8x8 but"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("is 16x8: compare needs images of the same size"), std::string::npos)
+      << r.err;
+}
+
+// A refused experiment leaves no directory behind: --out is created only for a run that
+// starts, and removed again when its outputs are refused.
+TEST(Experiment, ARefusedExperimentLeavesNoDirectory) {
+  const fs::path out = scratch() / "new" / "dir";
+  Result r = amalgam("experiment linear-cost --quick --scenes " + (scratch() / "missing").string() +
+                     " --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_FALSE(fs::exists(scratch() / "new")) << r.err;
+  // Its report on a directory where report.md is a directory: refused before any work.
+  fs::create_directories(scratch() / "taken" / "report.md");
+  r = amalgam("experiment linear-cost --quick --out " + (scratch() / "taken").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("report.md"), std::string::npos) << r.err;
+}
+
+// The volumetric renderer on a scene without meshes says so (it used to say the scene "was
+// loaded without volumetric amalgams").
+TEST(Volumetric, ASceneWithoutMeshesIsSaidToHaveNone) {
+  const std::string png = (scratch() / "v.png").string();
+  const Result r =
+      amalgam("render " + std::string(AMALGAM_SOURCE_DIR) +
+              "/scenes/spheres.json --renderer volumetric --width 8 --height 8 --out " + png);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("spheres.json has no meshes"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(png));
+}
+
+}  // namespace commands
+}  // namespace
