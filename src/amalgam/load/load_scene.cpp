@@ -1,9 +1,12 @@
 #include "amalgam/load/load_scene.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 
 #include "amalgam/io/json_reader.h"
 #include "amalgam/io/mesh_import.h"
@@ -71,6 +74,18 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
   return d;
 }
 
+namespace {
+
+/// The bytes this process holds in memory now (its resident set, /proc/self/statm).
+double resident_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  double pages = 0.0, resident = 0.0;
+  if (!(statm >> pages >> resident)) return 0.0;
+  return resident * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+}
+
+}  // namespace
+
 LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
@@ -100,6 +115,22 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
     const auto* ih = std::get_if<InstancedHierarchy>(&s.hierarchy);
     VolumeConfig volume = config.volume;
     if (light_probe().lines > 0) volume.lines = light_probe().lines;
+    // Held to the limit as it goes: what the process holds now (the scene as built), plus
+    // every block the bake is about to allocate, less what it has freed.
+    struct Limit final : BakeBudget {
+      const std::string& path;
+      const SceneFileConfig& config;
+      double used = resident_bytes();
+      Limit(const std::string& p, const SceneFileConfig& c) : path(p), config(c) {}
+      void charge(double bytes) override {
+        used += bytes;
+        if (bytes > 0.0 && used > static_cast<double>(config.max_bytes))
+          throw InputError(path + ": baking its volumetric amalgams needs more than " +
+                           config.limit_name + " (" + format_bytes(used) +
+                           " with the scene as built, counted before allocating)");
+      }
+    } limit(path, config);
+    if (config.max_bytes != 0) volume.budget = &limit;
     if (ih) {
       VolumeSet v = bake_volumes(*ih, objects, volume);
       // The seen-and-lit ratios serve the light probe's lit-share model alone.

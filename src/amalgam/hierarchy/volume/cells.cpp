@@ -91,6 +91,53 @@ float surface_grain(const std::vector<Vec3>& tris) {
   return sum > 0.0 ? static_cast<float>(weighted / sum) : 0.0f;
 }
 
+/// Numbers the cells of `per_level` (accumulator indices, -1: empty) level by level, in each
+/// level's linear order, and stores the dense indices, the surfaces and the normal histograms.
+void store_cells(CellGrid& g, const std::vector<std::vector<int>>& per_level,
+                 const std::vector<Acc>& accs, const BakeCharge& charge) {
+  const int nb = g.normal_bins();
+  // Ids level by level, in each level's linear order; the dense indices; the stored surfaces.
+  g.index_offset.resize(static_cast<std::size_t>(g.levels) + 1);
+  g.level_first.resize(static_cast<std::size_t>(g.levels) + 1);
+  std::uint32_t offset = 0, id = 0;
+  for (int L = 0; L < g.levels; ++L) {
+    g.index_offset[static_cast<std::size_t>(L)] = offset;
+    g.level_first[static_cast<std::size_t>(L)] = id;
+    const std::vector<int>& cur = per_level[static_cast<std::size_t>(L)];
+    offset += static_cast<std::uint32_t>(cur.size());
+    for (int ai : cur) id += ai >= 0 ? 1u : 0u;
+  }
+  g.index_offset[static_cast<std::size_t>(g.levels)] = offset;
+  g.level_first[static_cast<std::size_t>(g.levels)] = id;
+  // The grid as baked: its dense index, surfaces, normal histograms and the coverage tables.
+  charge.kept(offset * 4.0 +
+              id * (sizeof(CellSurface) + nb * 2.0 + 2.0 * g.dirs() * sizeof(std::uint16_t)));
+  g.index.assign(offset, 0);
+  g.surface.resize(id);
+  g.normals.assign(static_cast<std::size_t>(id) * nb, 0);
+  id = 0;
+  for (int L = 0; L < g.levels; ++L) {
+    const std::vector<int>& cur = per_level[static_cast<std::size_t>(L)];
+    for (std::size_t lin = 0; lin < cur.size(); ++lin) {
+      if (cur[lin] < 0) continue;
+      const Acc& a = accs[static_cast<std::size_t>(cur[lin])];
+      g.index[g.index_offset[static_cast<std::size_t>(L)] + lin] = id + 1;
+      CellSurface& s = g.surface[id];
+      s.area = static_cast<float>(a.area);
+      s.albedo =
+          Vec3{static_cast<float>(a.albedo[0] / a.area), static_cast<float>(a.albedo[1] / a.area),
+               static_cast<float>(a.albedo[2] / a.area)};
+      s.reflectance = static_cast<float>(a.reflectance / a.area);
+      double total = 0.0;
+      for (double h : a.hist) total += h;
+      for (int k = 0; k < nb; ++k)
+        g.normals[static_cast<std::size_t>(id) * nb + k] = static_cast<std::uint16_t>(
+            std::lround(65535.0 * a.hist[static_cast<std::size_t>(k)] / total));
+      ++id;
+    }
+  }
+}
+
 }  // namespace
 
 CellGrid bake_cells(const ExplicitHierarchy& mesh, const VolumeConfig& config) {
@@ -121,6 +168,9 @@ CellGrid bake_cells(const ExplicitHierarchy& mesh, const VolumeConfig& config) {
     hi = max(hi, max(p.a, max(p.b, p.c)));
   }
   if (source.empty()) return g;
+  BakeCharge charge(config);
+  charge.transient(static_cast<double>(prims.size() * sizeof(Primitive) +
+                                       tris.size() * sizeof(Vec3) + source.size() * 4));
   // The mesh's box, each edge at least a thousandth of the longest (a flat mesh gets a thin
   // box, not an empty one), widened by a few ulps so every vertex is inside.
   const Vec3 centre = (lo + hi) * 0.5f;
@@ -134,6 +184,10 @@ CellGrid bake_cells(const ExplicitHierarchy& mesh, const VolumeConfig& config) {
   const int fine = g.levels - 1;
   const int n = 1 << fine;
   const Vec3 cs = g.cell_size(fine);
+  // The dense accumulator indices of every level (8/7 of the finest's), and the accumulators
+  // in blocks of 1024, charged before they are made.
+  charge.transient(static_cast<double>(n) * n * n * sizeof(int) * 8.0 / 7.0);
+  const double acc_block = 1024.0 * (sizeof(Acc) + nb * sizeof(double) + 16.0);
   std::vector<int> fine_acc(static_cast<std::size_t>(n) * n * n, -1);
   std::vector<Acc> accs;
   double spec_area = 0.0, spec_shininess = 0.0;
@@ -179,6 +233,7 @@ CellGrid bake_cells(const ExplicitHierarchy& mesh, const VolumeConfig& config) {
           if (!(area > 0.0)) continue;
           const std::size_t lin = (static_cast<std::size_t>(z) * n + y) * n + x;
           if (fine_acc[lin] < 0) {
+            if (accs.size() % 1024 == 0) charge.transient(acc_block);
             fine_acc[lin] = static_cast<int>(accs.size());
             accs.emplace_back().hist.assign(static_cast<std::size_t>(nb), 0.0);
           }
@@ -208,6 +263,7 @@ CellGrid bake_cells(const ExplicitHierarchy& mesh, const VolumeConfig& config) {
           if (ci < 0) continue;
           const std::size_t lin = (static_cast<std::size_t>(z / 2) * m + y / 2) * m + x / 2;
           if (cur[lin] < 0) {
+            if (accs.size() % 1024 == 0) charge.transient(acc_block);
             cur[lin] = static_cast<int>(accs.size());
             accs.emplace_back().hist.assign(static_cast<std::size_t>(nb), 0.0);
           }
@@ -218,43 +274,7 @@ CellGrid bake_cells(const ExplicitHierarchy& mesh, const VolumeConfig& config) {
         }
   }
 
-  // Ids level by level, in each level's linear order; the dense indices; the stored surfaces.
-  g.index_offset.resize(static_cast<std::size_t>(g.levels) + 1);
-  g.level_first.resize(static_cast<std::size_t>(g.levels) + 1);
-  std::uint32_t offset = 0, id = 0;
-  for (int L = 0; L < g.levels; ++L) {
-    g.index_offset[static_cast<std::size_t>(L)] = offset;
-    g.level_first[static_cast<std::size_t>(L)] = id;
-    const std::vector<int>& cur = per_level[static_cast<std::size_t>(L)];
-    offset += static_cast<std::uint32_t>(cur.size());
-    for (int ai : cur) id += ai >= 0 ? 1u : 0u;
-  }
-  g.index_offset[static_cast<std::size_t>(g.levels)] = offset;
-  g.level_first[static_cast<std::size_t>(g.levels)] = id;
-  g.index.assign(offset, 0);
-  g.surface.resize(id);
-  g.normals.assign(static_cast<std::size_t>(id) * nb, 0);
-  id = 0;
-  for (int L = 0; L < g.levels; ++L) {
-    const std::vector<int>& cur = per_level[static_cast<std::size_t>(L)];
-    for (std::size_t lin = 0; lin < cur.size(); ++lin) {
-      if (cur[lin] < 0) continue;
-      const Acc& a = accs[static_cast<std::size_t>(cur[lin])];
-      g.index[g.index_offset[static_cast<std::size_t>(L)] + lin] = id + 1;
-      CellSurface& s = g.surface[id];
-      s.area = static_cast<float>(a.area);
-      s.albedo =
-          Vec3{static_cast<float>(a.albedo[0] / a.area), static_cast<float>(a.albedo[1] / a.area),
-               static_cast<float>(a.albedo[2] / a.area)};
-      s.reflectance = static_cast<float>(a.reflectance / a.area);
-      double total = 0.0;
-      for (double h : a.hist) total += h;
-      for (int k = 0; k < nb; ++k)
-        g.normals[static_cast<std::size_t>(id) * nb + k] = static_cast<std::uint16_t>(
-            std::lround(65535.0 * a.hist[static_cast<std::size_t>(k)] / total));
-      ++id;
-    }
-  }
+  store_cells(g, per_level, accs, charge);
   bake_coverage(g, tris, config);
   return g;
 }

@@ -56,6 +56,43 @@ struct VolumeConfig {
   /// Bake world cells across the instances too (world_cells.h); false: every instance is
   /// marched or traced on its own (to measure what world cells buy).
   bool world = true;
+  /// When set, told the bytes the bake is about to allocate, before it does (negative: what it
+  /// has freed); it may throw to stop the bake (the loader holds it to --max-memory). Not part
+  /// of what is baked.
+  class BakeBudget* budget = nullptr;
+  void charge(double bytes) const;
+};
+
+/// What a bake's allocations are charged to (VolumeConfig::budget).
+class BakeBudget {
+ public:
+  virtual ~BakeBudget() = default;
+  virtual void charge(double bytes) = 0;
+};
+
+inline void VolumeConfig::charge(double bytes) const {
+  if (budget) budget->charge(bytes);
+}
+
+/// The bytes one step of a bake charges to VolumeConfig::reserve: `transient` ones are freed
+/// (charged back) when the step ends, `kept` ones are the baked result's and stay charged.
+class BakeCharge {
+ public:
+  explicit BakeCharge(const VolumeConfig& config) : config_(config) {}
+  BakeCharge(const BakeCharge&) = delete;
+  BakeCharge& operator=(const BakeCharge&) = delete;
+  ~BakeCharge() {
+    if (held_ > 0.0) config_.charge(-held_);  // a release never throws
+  }
+  void transient(double bytes) {
+    config_.charge(bytes);
+    held_ += bytes;
+  }
+  void kept(double bytes) const { config_.charge(bytes); }
+
+ private:
+  const VolumeConfig& config_;
+  double held_ = 0.0;
 };
 
 /// The surface inside one cell.

@@ -16,6 +16,7 @@
 // fitted per level to lines traced through its real triangles.
 
 #include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -74,6 +75,22 @@ void first_hits(const CellGrid& g, std::span<const Vec3> tris, Vec3 d, int res, 
   }
 }
 
+/// A line of a direction bin that crosses the grid, with its first hit (infinity: none).
+struct Line {
+  Vec3 o;
+  float t0, t1, hit;
+};
+
+/// What the direction bins baked at once (one per thread) hold: each its lines' first hits (12
+/// bytes) and records (24), the cells' counts, and the crossings of the finest level (each line
+/// crosses at most 3 * 2^fine of its cells).
+double bins_bytes(const VolumeConfig& config, int dirs, int res, int fine, std::size_t cells) {
+  const int at_once = config.parallel ? std::min(dirs, tbb::this_task_arena::max_concurrency()) : 1;
+  const double lines = static_cast<double>(res) * res;
+  return at_once * (lines * (36.0 + 3.0 * (1 << fine) * sizeof(std::uint32_t)) +
+                    static_cast<double>(cells) * 12.0);
+}
+
 }  // namespace
 
 void bake_coverage(CellGrid& g, std::span<const Vec3> tris, const VolumeConfig& config) {
@@ -88,6 +105,8 @@ void bake_coverage(CellGrid& g, std::span<const Vec3> tris, const VolumeConfig& 
   const float radius = 0.5f * length(g.size) * 1.0001f;
   const int res = static_cast<int>(
       std::ceil(static_cast<float>(config.lines << fine) * 2.0f * radius / g.longest() * 1.0001f));
+  BakeCharge charge(config);
+  charge.transient(bins_bytes(config, dirs, res, fine, cells));
   const float pitch = 2.0f * radius / static_cast<float>(res);
   const float density = 1.0f / (pitch * pitch);  // lines per unit area across d
 
@@ -97,12 +116,7 @@ void bake_coverage(CellGrid& g, std::span<const Vec3> tris, const VolumeConfig& 
     Vec3 u, v, centre;
     first_hits(g, tris, d, res, radius, hash_combine(config.seed, static_cast<std::uint64_t>(b)),
                depth, jx, jy, u, v, centre);
-    // The lines that cross the cube, with their first hits (infinity: none).
-    struct Line {
-      Vec3 o;
-      float t0, t1, hit;
-    };
-    std::vector<Line> lines;
+    std::vector<Line> lines;           // those that cross the cube
     const float back = 2.0f * radius;  // lines start this far before the centre plane
     for (int j = 0; j < res; ++j)
       for (int i = 0; i < res; ++i) {
@@ -175,7 +189,8 @@ void bake_coverage(CellGrid& g, std::span<const Vec3> tris, const VolumeConfig& 
           const std::uint16_t* h = g.normals.data() + static_cast<std::size_t>(c) * g.normal_bins();
           float mean_cos = 0.0f;
           for (int k = 0; k < g.normal_bins(); ++k)
-            mean_cos += static_cast<float>(h[k]) * std::fabs(dot(g.normal_dirs[static_cast<std::size_t>(k)], d));
+            mean_cos += static_cast<float>(h[k]) *
+                        std::fabs(dot(g.normal_dirs[static_cast<std::size_t>(k)], d));
           const float tau = g.surface[c].area * mean_cos / 65535.0f / g.projected_area(L, d);
           store(g.coverage, c, 1.0f - std::exp(-tau));
         }

@@ -22,6 +22,7 @@ VolumeSet bake_volumes(const InstancedHierarchy& h, std::size_t object_meshes,
     v.world_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
+  v.config.budget = nullptr;  // the bake's account, not part of the result
   return v;
 }
 

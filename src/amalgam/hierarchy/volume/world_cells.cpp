@@ -109,7 +109,7 @@ class WorldBake {
   }
 
   /// Bakes every level, finest first; returns them coarsest first.
-  std::vector<LevelSums> bake(const std::vector<std::uint32_t>& absorbed) {
+  std::vector<LevelSums> bake(const std::vector<std::uint32_t>& absorbed, BakeCharge& charge) {
     // The absorbed instances by (absorb level, cell there, instance): each cell's instances
     // are summed in instance order, whatever the thread count.
     struct Item {
@@ -118,6 +118,7 @@ class WorldBake {
       std::uint32_t instance;
     };
     std::vector<Item> items;
+    charge.transient(static_cast<double>(absorbed.size() * sizeof(Item)));
     items.reserve(absorbed.size());
     for (std::uint32_t i : absorbed)
       items.push_back(
@@ -150,6 +151,7 @@ class WorldBake {
         for (std::uint64_t k : finer->keys) ls.keys.push_back(parent_key(level, k));
       std::sort(ls.keys.begin(), ls.keys.end());
       ls.keys.erase(std::unique(ls.keys.begin(), ls.keys.end()), ls.keys.end());
+      charge.transient(static_cast<double>(ls.keys.size() * (stride * sizeof(double) + 8)));
       ls.acc.assign(ls.keys.size() * stride, 0.0);
       const auto slot = [&](std::uint64_t key) {
         return static_cast<std::size_t>(std::lower_bound(ls.keys.begin(), ls.keys.end(), key) -
@@ -286,8 +288,15 @@ WorldCells bake_world_cells(const InstancedHierarchy& h, const std::vector<CellG
   }
 
   // Bake, then number the cells level by level and fill the dense index.
-  const std::vector<LevelSums> levels = bake.bake(absorbed);
+  BakeCharge charge(config);
+  const std::vector<LevelSums> levels = bake.bake(absorbed, charge);
   const auto stride = static_cast<std::size_t>(Sums{w.dirs(), w.normal_bins()}.stride());
+  // The cells as stored: the dense index, then per cell its extinctions, normal histogram,
+  // surface and grain.
+  double cells = 0.0;
+  for (const LevelSums& ls : levels) cells += static_cast<double>(ls.keys.size());
+  charge.kept(entries * 4.0 + cells * (w.dirs() * sizeof(float) + w.normal_bins() * 2.0 +
+                                       sizeof(CellSurface) + sizeof(float)));
   w.index.assign(entries, 0u);
   double shine = 0.0, shine_w = 0.0;
   for (int level = 0; level < w.levels; ++level) {
