@@ -255,8 +255,10 @@ TEST(BadInput, DeclaredSizesAndIndicesTheFileCannotHoldAreRefused) {
                  R"("accessors":[{"bufferView":0,"byteOffset":1.5,"componentType":5126,)"
                  R"("count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}]})");
   write_file(d / "index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n");
-  write_file(d / "negative.off", "OFF 3 1 0\n# a comment\n0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n");
-  write_file(d / "fraction.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n\n3 0 1.5 2\n");
+  // Assimp 5.2 reads -1 and 2.5 as some vertex: these imported (two triangles) and rendered.
+  write_file(d / "negative.off",
+             "OFF 4 2 0\n# a comment\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 -1 2\n");
+  write_file(d / "fraction.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n\n3 0 1 2\n3 1 2.5 2\n");
   write_file(d / "list.ply",
              "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
              "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
@@ -274,10 +276,10 @@ TEST(BadInput, DeclaredSizesAndIndicesTheFileCannotHoldAreRefused) {
        "face 0 has vertex index '9': expected a whole number below 3, the vertices the header "
        "declares"},
       {"negative.off",
-       "face 0 has vertex index '-1': expected a whole number below 3, the vertices the header "
+       "face 1 has vertex index '-1': expected a whole number below 4, the vertices the header "
        "declares"},
       {"fraction.off",
-       "face 0 has vertex index '1.5': expected a whole number below 3, the vertices the header "
+       "face 1 has vertex index '2.5': expected a whole number below 4, the vertices the header "
        "declares"},
       {"list.ply",
        "corrupt data: Unable to parse property instance. Skipping this element instance"},
