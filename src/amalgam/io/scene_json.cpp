@@ -392,11 +392,7 @@ class SceneParser {
         std::vector<Affine> where;
         for (const JsonValue& e : r_.items(*t)) where.push_back(scene_json::read_transform(r_, e));
         p.count = where.size();
-        p.where = [where, local] {
-          std::vector<Affine> w = where;
-          for (Affine& a : w) a = a * local;
-          return w;
-        };
+        p.where = [where, local] { return placed(where, local); };
       } else if (auto g = r_.find(in, "grid")) {
         const GridPattern grid = scene_json::read_grid(r_, *g);
         p.count = static_cast<std::size_t>(grid.nx * grid.nz);
