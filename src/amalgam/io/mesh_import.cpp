@@ -1,5 +1,6 @@
 #include "amalgam/io/mesh_import.h"
 
+#include <dlfcn.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
@@ -34,6 +35,27 @@ std::string errno_text(int err) {
   return std::error_code(err, std::generic_category()).message();
 }
 
+std::mutex& registered_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+std::string& registered_helper() {
+  static std::string path;
+  return path;
+}
+
+/// The file of the executable or shared object that holds this code.
+fs::path this_object() {
+  Dl_info info{};
+  if (::dladdr(reinterpret_cast<const void*>(&this_object), &info) == 0 ||
+      info.dli_fname == nullptr)
+    return {};
+  std::error_code ec;
+  const fs::path p = fs::weakly_canonical(info.dli_fname, ec);
+  return ec ? fs::path() : p;
+}
+
 /// The helper to run (see ImportConfig::helper).
 std::string find_helper(const ImportConfig& config) {
   if (!config.helper.empty()) return config.helper;
@@ -41,22 +63,37 @@ std::string find_helper(const ImportConfig& config) {
     return env;
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    const fs::path beside = self.parent_path() / "amalgam-import";
-    if (fs::is_regular_file(beside, ec)) return beside.string();
+  std::vector<fs::path> candidates;
+  if (!self.empty()) candidates.push_back(self.parent_path() / "amalgam-import");
+  {
+    const std::lock_guard lock(registered_mutex());
+    if (!registered_helper().empty()) candidates.emplace_back(registered_helper());
   }
-#ifdef AMALGAM_IMPORT_HELPER_INSTALL_PATH  // a program linked against an installed amalgam
-  if (fs::is_regular_file(AMALGAM_IMPORT_HELPER_INSTALL_PATH, ec))
-    return AMALGAM_IMPORT_HELPER_INSTALL_PATH;
+#ifdef AMALGAM_IMPORT_HELPER_FROM_MODULE  // the installed Python module: its bin directory
+  if (const fs::path object = this_object(); !object.empty() && object != self)
+    candidates.push_back(object.parent_path() / AMALGAM_IMPORT_HELPER_FROM_MODULE);
+#endif
+#ifdef AMALGAM_IMPORT_HELPER_INSTALL_PATH  // installed where it was configured to be
+  candidates.emplace_back(AMALGAM_IMPORT_HELPER_INSTALL_PATH);
 #endif
 #ifdef AMALGAM_IMPORT_HELPER_BUILD_PATH
-  if (fs::is_regular_file(AMALGAM_IMPORT_HELPER_BUILD_PATH, ec))
-    return AMALGAM_IMPORT_HELPER_BUILD_PATH;
+  candidates.emplace_back(AMALGAM_IMPORT_HELPER_BUILD_PATH);
 #endif
+  for (const fs::path& c : candidates)
+    if (fs::is_regular_file(c, ec)) return c.lexically_normal().string();
   throw RuntimeError("cannot find the mesh importer 'amalgam-import' (looked next to " +
                      (self.empty() ? std::string("the running executable") : self.string()) +
                      "; set AMALGAM_IMPORT_HELPER to its path)");
 }
+
+}  // namespace
+
+void register_import_helper(std::string path) {
+  const std::lock_guard lock(registered_mutex());
+  registered_helper() = std::move(path);
+}
+
+namespace {
 
 /// A running helper: its pid and the read end of its stdout. Unless reap() was called, the
 /// destructor kills (SIGKILL) and reaps it, so no failure on our side leaves it running.

@@ -56,10 +56,12 @@ struct ImportConfig {
   /// killed and the import is an InputError. 0: the environment variable
   /// AMALGAM_IMPORT_TIMEOUT (seconds) if set, else 300 s plus 1 s per MiB of the file.
   double timeout_seconds = 0;
-  /// The helper executable that runs Assimp. Empty: the environment variable
-  /// AMALGAM_IMPORT_HELPER if set and not empty, else `amalgam-import` in the directory of the
-  /// running executable (/proc/self/exe) if it is there, else the one of the build tree
-  /// (AMALGAM_IMPORT_HELPER_BUILD_PATH, compiled in).
+  /// The helper executable that runs Assimp. Empty: the first that exists of the environment
+  /// variable AMALGAM_IMPORT_HELPER (if set and not empty); `amalgam-import` in the directory
+  /// of the running executable (/proc/self/exe: the installed CLI); the one an installed CMake
+  /// package registered (register_import_helper: a program built with find_package(amalgam));
+  /// the one in the install's bin directory as seen from the shared object that holds this
+  /// code (the installed Python module); the configured install prefix's; the build tree's.
   std::string helper;
 };
 
@@ -79,5 +81,11 @@ struct ImportConfig {
 /// logger stays silent and the helper's stderr goes to /dev/null. Thread-safe: concurrent imports
 /// run in separate helpers. A helper never outlives the process that started it.
 ImportedMesh import_mesh(const std::string& path, const ImportConfig& config = {});
+
+/// Names the helper of an installed amalgam for ImportConfig::helper's search. The CMake
+/// package (find_package(amalgam)) compiles a call into every program that links amalgam::io,
+/// with the path of the `amalgam-import` installed beside the package, wherever the install
+/// was moved; a program may call it too. Thread-safe; the last call wins.
+void register_import_helper(std::string path);
 
 }  // namespace amalgam
