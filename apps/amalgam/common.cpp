@@ -1,9 +1,11 @@
 #include "common.h"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <sstream>
 #include <system_error>
@@ -65,7 +67,7 @@ void CommonOptions::add_view_to(CLI::App& app) {
   app.add_option("--threads", threads, "worker threads (default: all cores)")
       ->check(non_negative_int());
   app.add_option("--camera", camera,
-                 "view from the scene file's camera NAME or INDEX (glTF; default: the first)");
+                 "view from the scene file's camera NAME or INDEX (default: the first)");
   app.add_option("--eye", eye, "camera position x,y,z (replaces the scene's)");
   app.add_option("--look-at", look_at, "point the camera looks at, x,y,z");
   app.add_option("--up", up, "camera up direction x,y,z");
@@ -81,6 +83,28 @@ void CommonOptions::add_view_to(CLI::App& app) {
 
 void CommonOptions::prepare(LoadedScene& scene) const {
   choose_camera(scene, view);
+}
+
+std::string dark_view(const RenderOutput& r) {
+  constexpr float kDark = 0.02f;
+  bool hit = false;
+  float brightest = 0.0f;
+  for (std::size_t i = 0; i < r.image.size(); ++i) {
+    if (i < r.depth.size() && !std::isfinite(r.depth[i])) continue;  // a miss: the background
+    hit = true;
+    const Vec3 c = r.image[i];
+    brightest = std::max({brightest, c.x, c.y, c.z});
+  }
+  if (r.image.empty()) return {};
+  if (!hit)
+    return "no camera ray met the scene: the view looks away from it (`amalgam info` prints its "
+           "bounds and cameras; --camera, --eye, --look-at set the view)";
+  if (brightest >= kDark) return {};
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.3g", brightest);
+  return std::string("almost no light reaches what the camera sees (brightest pixel ") + buf +
+         "): the view may face the unlit side, or the file's lights be too weak for its size "
+         "(`amalgam info` lists them; docs/import.md, light units)";
 }
 
 void print_warnings(const LoadedScene& scene) {

@@ -1,4 +1,5 @@
-/// The `amalgam` command line: render, trace, scenes, experiment, compare, advise (docs/cli.md).
+/// The `amalgam` command line: render, trace, info, scenes, experiment, compare, advise
+/// (docs/cli.md).
 
 #include <CLI/CLI.hpp>
 #include <cerrno>
@@ -40,7 +41,8 @@ namespace {
 
 /// The subcommands, what each parsed into, and whether it was given.
 struct Commands {
-  amalgam::cli::CommonOptions render_opts, trace_opts, advise_opts;
+  amalgam::cli::CommonOptions render_opts, trace_opts, advise_opts, info_opts;
+  bool info_json = false;
   amalgam::cli::RenderExtras extras;
   CLI::Option* max_memory = nullptr;
   std::string origin, direction;  ///< trace
@@ -50,7 +52,7 @@ struct Commands {
   amalgam::cli::CompareOptions cmp;
   amalgam::cli::AdviseOptions adv;
   CLI::App *render = nullptr, *trace = nullptr, *experiment = nullptr, *compare = nullptr,
-           *advise = nullptr;
+           *advise = nullptr, *info = nullptr;
 };
 
 void add_render(CLI::App& app, Commands& c, int argc, char** argv) {
@@ -116,6 +118,15 @@ void add_trace(CLI::App& app, Commands& c) {
       ->check(cli::positive_int());
   c.trace->add_option("--height", c.trace_opts.options.height, "image height (default 512)")
       ->check(cli::positive_int());
+}
+
+void add_info(CLI::App& app, Commands& c) {
+  c.info = app.add_subcommand("info",
+                              "what a scene holds, without rendering: bounds, primitives and "
+                              "instances, cameras, lights, and the view a render would use");
+  c.info_opts.add_scene_to(*c.info);
+  c.info_opts.add_view_to(*c.info);
+  c.info->add_flag("--json", c.info_json, "print it as JSON");
 }
 
 void add_experiment(CLI::App& app, Commands& c) {
@@ -227,6 +238,7 @@ int run(Commands& c) {
   namespace cli = amalgam::cli;
   if (c.render->parsed()) return cli::run_render(c.render_opts, c.extras);
   if (c.trace->parsed()) return cli::run_trace(c.trace_opts, c.origin, c.direction);
+  if (c.info->parsed()) return cli::run_info(c.info_opts, c.info_json);
   if (c.experiment->parsed())
     return cli::run_experiment(c.exp_name, c.exp_out, c.exp_quick, c.exp_threads, c.exp_scenes,
                                c.exp_partial);
@@ -251,6 +263,7 @@ int main(int argc, char** argv) {
   Commands c;
   add_render(app, c, argc, argv);
   add_trace(app, c);
+  add_info(app, c);
   app.add_subcommand("scenes", "list the builtin scenes and their parameters");
   add_experiment(app, c);
   add_compare(app, c);

@@ -247,6 +247,8 @@ void finish_complete(const RenderExtras& extra, const std::string& ckpt, const P
       std::filesystem::remove(t.path, ec);
   } catch (const InputError&) {  // its directory went away meanwhile: nothing to remove
   }
+  if (const std::string dark = dark_view(r); !dark.empty())
+    std::cerr << "amalgam: warning: " << extra.out << ": " << dark << "\n";
   if (extra.quiet) return;
   std::cerr << "amalgam: wrote " << extra.out << " (" << r.width << "x" << r.height << ", " << r.spp
             << " spp, " << r.seconds << " s, ";

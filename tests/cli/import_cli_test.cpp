@@ -1,6 +1,6 @@
 // End-to-end: scenes imported faithfully (docs/import.md). Textured glTF renders textured,
-// glTF cameras and the view options, one warning line per dropped kind of content, and the
-// --camera errors.
+// the cameras of glTF and other formats and the view options, one warning line per dropped
+// kind of content, the --camera errors, `info`, and the warning on a view that shows nothing.
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -177,6 +177,73 @@ TEST(SceneImportCli, CameraErrorsAreInputErrors) {
   // The view options work on any scene.
   const CliResult ok = run("trace builtin:demo --eye 0,3,9 --look-at 0,0,0 --fov 30");
   EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
+const fs::path kModels = "/usr/share/assimp/models";
+
+/// `amalgam info ARGS`: its standard output.
+std::string info(const std::string& args) {
+  const fs::path out = scratch() / "info.txt";
+  const int status = amalgam::test::run_command(std::string(AMALGAM_BINARY) + " info " + args +
+                                                " >" + out.string() + " 2>/dev/null")
+                         .status;
+  EXPECT_EQ(status, 0) << args;
+  return amalgam::test::slurp(out);
+}
+
+// The Collada duck faced its unlit side from the default framing: its camera (Assimp's full
+// horizontal angle, 54.43 degrees at aspect 1.5) is the view now, with the file's yfov.
+TEST(SceneImportCli, InfoPrintsAColladaFilesCameraAndARenderUsesIt) {
+  const std::string duck = (kModels / "Collada/duck.dae").string();
+  ASSERT_TRUE(fs::is_regular_file(duck)) << "install assimp-testmodels (scripts/deps.sh)";
+  const std::string text = info("'" + duck + "'");
+  EXPECT_NE(text.find("cameras     1\n  0 'camera1': --eye "), std::string::npos) << text;
+  EXPECT_NE(text.find("--fov 37.849"), std::string::npos) << text;
+  EXPECT_NE(text.find("render view the file's first camera 'camera1'\n"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("primitives  4,212 in "), std::string::npos) << text;
+  EXPECT_NE(text.find("lights      1\n  directional toward "), std::string::npos) << text;
+  const std::string json = info("'" + duck + "' --json");
+  EXPECT_NE(json.find("\"render_camera_from\": \"the file's first camera 'camera1'\""),
+            std::string::npos)
+      << json;
+  // The render's default view is that camera, and the duck is lit: yellow pixels.
+  const fs::path seen = render(duck, "duck");
+  EXPECT_EQ(bytes(seen), bytes(render(duck, "duck0", "--camera 0")));
+  int yellow = 0;
+  for (const amalgam::Vec3& p : pixels(seen))
+    yellow += p.x > 0.3f && p.y > 0.2f && p.z < 0.5f * p.x;
+  EXPECT_GT(yellow, 50);  // measured 97 of 9216 pixels
+  // A scene file without cameras: its instances and meshes.
+  const std::string demo = info("builtin:demo --eye 0,3,9");
+  EXPECT_NE(demo.find("the scene's camera, changed by the view options\n  --eye 0,3,9 "),
+            std::string::npos)
+      << demo;
+}
+
+// A view that shows nothing says why in one warning: no camera ray met the scene, or almost
+// no light reaches what it sees (Blender's default cube: a lamp of intensity 1 seven units
+// away; measured brightest pixel 0.0072).
+TEST(SceneImportCli, AViewThatShowsNothingIsOneWarning) {
+  const std::string cube = (kModels / "BLEND/BlenderDefault_276.blend").string();
+  const std::string wuson = (kModels / "PLY/Wuson.ply").string();
+  ASSERT_TRUE(fs::is_regular_file(cube)) << "install assimp-testmodels (scripts/deps.sh)";
+  const std::string out =
+      " --width 48 --height 36 --spp 1 --quiet --out " + (scratch() / "dark.png").string();
+  const CliResult dark = run("render '" + cube + "'" + out);
+  ASSERT_EQ(dark.status, 0) << dark.err;
+  EXPECT_NE(dark.err.find(": almost no light reaches what the camera sees (brightest pixel 0.00"),
+            std::string::npos)
+      << dark.err;
+  const CliResult away = run("render '" + wuson + "' --eye 0,0,5 --look-at 0,0,10" + out);
+  ASSERT_EQ(away.status, 0) << away.err;
+  EXPECT_EQ(lines(away.err).size(), 1u) << away.err;
+  EXPECT_NE(away.err.find(": no camera ray met the scene"), std::string::npos) << away.err;
+  // Lit views say nothing of the kind.
+  for (const std::string& lit : {wuson, (kModels / "Collada/duck.dae").string()}) {
+    const CliResult r = run("render '" + lit + "'" + out);
+    EXPECT_EQ(r.err.find("camera"), std::string::npos) << r.err;
+  }
 }
 
 }  // namespace import_cli

@@ -4,6 +4,7 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -180,19 +181,23 @@ bool finite(Vec3 v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
-}  // namespace
-
-void read_cameras_lights(const aiScene& scene, const std::string& path, bool gltf,
-                         ImportedMesh& out) {
-  Notes notes(path);
+/// The file's perspective cameras placed by their nodes, into `out.cameras`; what cannot be
+/// used, into `notes`.
+void read_cameras(const aiScene& scene, const std::string& path, bool gltf, Notes& notes,
+                  ImportedMesh& out) {
   constexpr float kDeg = 180.0f / std::numbers::pi_v<float>;
+  std::string ext = fs::path(path).extension().string();
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  const bool three_ds = ext == ".3ds" || ext == ".prj";
   for (unsigned i = 0; i < scene.mNumCameras; ++i) {
     const aiCamera* c = scene.mCameras[i];
     if (c == nullptr) continue;
     const std::string name = quoted(c->mName);
     const aiNode* node = scene.mRootNode ? scene.mRootNode->FindNode(c->mName) : nullptr;
-    if (!gltf) {
-      notes.add("cameras not used (they are read from glTF files only)", name);
+    if (three_ds) {
+      // Assimp 5.2 adds a 3DS camera's position twice (node and mPosition) and loses its
+      // target: the view it gives looks away from the scene.
+      notes.add("3DS cameras not used (Assimp misplaces them)", name);
       continue;
     }
     if (c->mHorizontalFOV == 0.0f || c->mOrthographicWidth > 0.0f) {
@@ -203,15 +208,23 @@ void read_cameras_lights(const aiScene& scene, const std::string& path, bool glt
       notes.add("cameras placed by no node, not used", name);
       continue;
     }
-    // Assimp 5.2's glTF 2 importer stores yfov * aspectRatio as the horizontal field of view
-    // (yfov when there is no aspect ratio), and the node's translation as mPosition although
-    // the node transform holds it too: a glTF camera sits at its node's origin, looking down
-    // its -z axis with +y up.
     const aiMatrix4x4 g = global_transform(node);
     const float aspect = c->mAspect > 0.0f ? c->mAspect : 1.0f;
     Camera cam;
-    cam.vfov_deg = c->mHorizontalFOV / aspect * kDeg;
-    cam.position = point(g, aiVector3D(0, 0, 0));
+    if (gltf) {
+      // Assimp 5.2's glTF 2 importer stores yfov * aspectRatio as the horizontal field of view
+      // (yfov when there is no aspect ratio), and the node's translation as mPosition although
+      // the node transform holds it too: a glTF camera sits at its node's origin, looking down
+      // its -z axis with +y up.
+      cam.vfov_deg = c->mHorizontalFOV / aspect * kDeg;
+      cam.position = point(g, aiVector3D(0, 0, 0));
+    } else {
+      // The other importers (Collada, FBX, OpenGEX, 3DS, ...) store the full horizontal angle
+      // (Collada's yfov 37.85 at aspect 1.5 comes as 54.43 degrees), mPosition, mLookAt and
+      // mUp in the node's space; without an aspect ratio the film is taken as square.
+      cam.vfov_deg = 2.0f * std::atan(std::tan(0.5f * c->mHorizontalFOV) / aspect) * kDeg;
+      cam.position = point(g, c->mPosition);
+    }
     const Vec3 dir = vector(g, c->mLookAt), up = vector(g, c->mUp);
     const float scale = std::max(1.0f, max_component(abs(cam.position)));
     if (!(cam.vfov_deg > 0.0f && cam.vfov_deg < 180.0f) || !finite(cam.position) || !finite(dir) ||
@@ -224,6 +237,14 @@ void read_cameras_lights(const aiScene& scene, const std::string& path, bool glt
     cam.up = normalize(up);
     out.cameras.push_back({one_line(c->mName.C_Str(), 200), cam});
   }
+}
+
+}  // namespace
+
+void read_cameras_lights(const aiScene& scene, const std::string& path, bool gltf,
+                         ImportedMesh& out) {
+  Notes notes(path);
+  read_cameras(scene, path, gltf, notes, out);
   for (unsigned i = 0; i < scene.mNumLights; ++i) {
     const aiLight* l = scene.mLights[i];
     if (l == nullptr) continue;

@@ -15,8 +15,8 @@ namespace amalgam::assimp_scene {
 
 /// The cameras and lights of `scene` in world space, placed by their nodes. Call before the
 /// node transforms are baked into the vertices (aiProcess_PreTransformVertices drops the
-/// nodes). Cameras are read from glTF files only (`gltf`): Assimp's other importers disagree
-/// on what its field of view means. What cannot be rendered is a line of `out.dropped`.
+/// nodes). `gltf`: the file is glTF, whose importer stores its cameras in its own way. What
+/// cannot be rendered is a line of `out.dropped`.
 void read_cameras_lights(const aiScene& scene, const std::string& path, bool gltf,
                          ImportedMesh& out);
 
