@@ -1,11 +1,14 @@
 #pragma once
 /// \file What `render` shows on a terminal while it works: the phase it is in (reading,
-/// building and baking) once a phase takes over a second, then a progress bar over the samples.
+/// building and baking) once a phase takes over a second, then a progress bar over the pixel
+/// samples.
 /// Nothing is shown when stderr is not a terminal or with --quiet; every line shown is ended
 /// before anything else is printed.
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -43,24 +46,40 @@ class PhaseStatus {
   std::thread thread_;
 };
 
-/// A one-line progress bar with ETA over the samples per pixel, after progress_delay().
+/// A one-line progress bar with an estimate of the time left, over the pixel samples of a
+/// render (pixels x samples per pixel), shown after progress_delay() and updated four times a
+/// second by a thread of its own: the render adds each finished block's pixel samples to
+/// counter() (RenderControl::pixel_samples), so the bar moves within a pass of samples.
 class Progress {
  public:
-  Progress(int total, bool enabled);
+  /// `pixels` per sample, `spp` samples in all, `spp_done` of them already there (a resumed
+  /// render: not counted in the rate).
+  Progress(std::uint64_t pixels, int spp, int spp_done, bool enabled);
   ~Progress() { finish(); }
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
-  void update(int done);
-  /// Ends the bar's line if one was shown, so that what follows starts a line of its own.
+  std::atomic<std::uint64_t>* counter() { return &done_; }
+  /// A pass of samples is complete: `spp_done` samples of every pixel are there (for renders
+  /// that count no blocks, e.g. across MPI ranks).
+  void passes_done(int spp_done);
+  /// Stops the display and ends the bar's line if one was shown, so that what follows starts
+  /// a line of its own; idempotent.
   void finish();
 
  private:
   using clock = std::chrono::steady_clock;
-  int total_;
+  void run();
+  std::uint64_t pixels_, total_, before_;
+  int spp_;
   bool enabled_;
   double delay_;
+  std::atomic<std::uint64_t> done_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stopping_ = false;
   bool shown_ = false;
   clock::time_point start_ = clock::now();
+  std::thread thread_;
 };
 
 }  // namespace amalgam::cli

@@ -296,13 +296,15 @@ void say_interrupted(const RenderExtras& extra, int spp_asked, const std::string
 RenderOutput render_with_progress(const RenderOptions& o, const RenderExtras& extra,
                                   const std::string& ckpt, const Prepared& p,
                                   const std::function<RenderOutput(const RenderControl&)>& render) {
-  Progress progress(o.spp, !extra.quiet);
+  Progress progress(static_cast<std::uint64_t>(o.width) * static_cast<std::uint64_t>(o.height),
+                    o.spp, p.state.spp_done, !extra.quiet);
   auto last_checkpoint = std::chrono::steady_clock::now();
   bool warned = false;
   RenderControl control;
   control.cancel = &g_cancel;
+  control.pixel_samples = progress.counter();
   control.on_pass = [&](const FilmState& st) {
-    progress.update(st.spp_done);
+    progress.passes_done(st.spp_done);
     const auto now = std::chrono::steady_clock::now();
     if (st.spp_done < o.spp &&
         std::chrono::duration<double>(now - last_checkpoint).count() >= extra.checkpoint_every) {

@@ -9,6 +9,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -170,6 +172,36 @@ TEST(Volumetric, TheBakeIsHeldToTheMemoryLimit) {
                     "--spp 1 --quiet --max-memory " + ample + " --out " + png)
                 .status,
             0);
+}
+
+/// What `command` prints on its standard output (and stderr, if it redirects it there).
+std::string output_of(const std::string& command) {
+  std::string out;
+  FILE* p = popen(command.c_str(), "r");
+  if (p == nullptr) return out;
+  char buf[4096];
+  for (std::size_t n; (n = fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
+  pclose(p);
+  return out;
+}
+
+// On a terminal the bar moves as blocks of pixels finish, not once per pass of samples: a
+// render of one sample per pixel (one pass) showed nothing until 100 %.
+TEST(Progress, TheBarMovesWithinAPassOfSamples) {
+  ASSERT_EQ(std::system("command -v script >/dev/null 2>&1"), 0) << "script(1) (bsdutils) missing";
+  const std::string out = output_of(
+      "AMALGAM_PROGRESS_AFTER=0 script -qec '" + std::string(AMALGAM_BINARY) +
+      " render builtin:prisms --set depth=8 --set view=corner --width 512 --height 512 --spp 1 "
+      "--threads 1 --out " +
+      (scratch() / "bar.pfm").string() + "' /dev/null");
+  int below_full = 0;  // percentages shown before the end (measured: about 25 in 0.6 s)
+  for (std::size_t at = out.find("% of 1 spp"); at != std::string::npos;
+       at = out.find("% of 1 spp", at + 1)) {
+    const int percent = std::atoi(out.substr(at - 3, 3).c_str());
+    below_full += percent > 0 && percent < 100;
+  }
+  EXPECT_GE(below_full, 2) << out;
+  EXPECT_NE(out.find("ETA"), std::string::npos) << out;
 }
 
 }  // namespace commands

@@ -114,6 +114,11 @@ bool render_passes(const Camera& camera, const RenderOptions& o, FilmState& st,
                        pass_tests[pix], pass_aov[pix]);
         }
       }
+      if (control.pixel_samples)
+        control.pixel_samples->fetch_add(static_cast<std::uint64_t>(y1 - y0) *
+                                             static_cast<std::uint64_t>(x1 - x0) *
+                                             static_cast<std::uint64_t>(s1 - s0),
+                                         std::memory_order_relaxed);
     };
     Counters counters;
     CostDistribution per_primary;

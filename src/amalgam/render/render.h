@@ -90,8 +90,12 @@ struct RenderControl {
   /// When it becomes true, the render stops at the next tile; the unfinished pass of samples is
   /// discarded and the output holds the completed ones.
   const std::atomic<bool>* cancel = nullptr;
-  /// Called after every completed pass (progress display, checkpoints).
+  /// Called after every completed pass (checkpoints).
   std::function<void(const FilmState&)> on_pass;
+  /// If set, each finished block of pixels adds its pixel samples (pixels x samples of the
+  /// pass) as it finishes, from the worker threads: a display polls it for progress within a
+  /// pass. A discarded pass's blocks stay counted.
+  std::atomic<std::uint64_t>* pixel_samples = nullptr;
 };
 
 /// Renders the scene's camera view progressively with amalgam's traversal (options.tracer must
