@@ -28,7 +28,9 @@ at 1024x768 and its far band at 512x384; about 20 s; update also rewrites docs/i
 paper (the verdict counts of docs/paper-reproduction.md, which
 scripts/plots/regenerate-docs.sh writes from `amalgam experiment all`), yardstick (the
 README's summary of the sections of docs/yardstick.md that scripts/yardstick.sh writes: best
-speed-ups and commits), stamps
+speed-ups and commits), volumetric (the cost of `--renderer volumetric` that docs/volumetric.md
+quotes, read from docs/volumetric/results.md, which scripts/volumetric_eval.py writes; no
+render), stamps
 (each hand-written reading of a generated run names that run's commit or date: regenerating
 the run without rewriting its reading fails the check), advise (`amalgam advise` on the field's
 street and aerial views and the meadow: timings only, so `update --only advise` writes them
@@ -322,6 +324,58 @@ def stamp_values():
     return v
 
 
+# --- volumetric: what --renderer volumetric costs, from docs/volumetric/results.md ----------
+
+VOLUMETRIC_RESULTS = "docs/volumetric/results.md"
+
+
+def volumetric_values():
+    """Per view of the table scripts/volumetric_eval.py writes: time per sample and tests per
+    camera ray of the volumetric renderer beside full detail's (the traditional renderer, same
+    samples and seeds), the error of the object against full detail, the bake; and the run's
+    machine, date and commit."""
+    text = (ROOT / VOLUMETRIC_RESULTS).read_text()
+    m = re.search(r"^Measured by `[^`]*` on (.+)\.$", text, re.M)
+    if m is None:
+        sys.exit(f"figures.py: {VOLUMETRIC_RESULTS}: no \"Measured by `...` on ...\" line")
+    v = {"volumetric.stamp": m.group(1)}
+    rows, header = {}, None
+    for line in text.splitlines():
+        if not line.startswith("|"):
+            if header is not None:
+                break
+            continue
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if header is None:
+            if cells[:3] != ["view", "object px", "renderer"]:
+                continue
+            header = cells
+        elif not set(cells[0]) <= set("-:"):
+            rows[(cells[0], cells[2])] = dict(zip(header, cells))
+    if not rows:
+        sys.exit(f"figures.py: {VOLUMETRIC_RESULTS}: no table starting | view | object px | renderer |")
+    objects = []  # the views of single objects: (time ratio, tests ratio)
+    for (view, renderer), vol in rows.items():
+        full = rows.get((view, "traditional"))
+        if renderer != "volumetric" or full is None:
+            continue
+        tv, tf = float(vol["ns per sample"]), float(full["ns per sample"])
+        nv, nf = float(vol["tests per ray (object)"]), float(full["tests per ray (object)"])
+        v[f"volumetric.{view}.px"] = vol["object px"]
+        v[f"volumetric.{view}.time"] = f"{tv:,.0f} / {tf:,.0f} ns ({tv / tf:.2f}x)"
+        v[f"volumetric.{view}.tests"] = f"{nv:.1f} / {nf:.1f} ({nv / nf:.2f}x)"
+        v[f"volumetric.{view}.error"] = vol["object vs full detail"]
+        v[f"volumetric.{view}.bake"] = vol["bake s"]
+        v[f"volumetric.{view}.time-ratio"] = f"{tv / tf:.2f}x"
+        if "meadow" not in view:
+            objects.append((tv / tf, nv / nf))
+    if objects:
+        t, n = [x for x, _ in objects], [y for _, y in objects]
+        v["volumetric.objects.time-range"] = f"{min(t):.2f}-{max(t):.2f}x"
+        v["volumetric.objects.tests-range"] = f"{min(n):.2f}-{max(n):.2f}x"
+    return v
+
+
 # --- field: docs/real-scenes.md (scenes/field.json at 1024x768 and its far band) -----------
 
 FIELD_RUNS = [("ss4", ["--footprint", "1", "--spp", "4"]), ("ss1", ["--footprint", "1", "--spp", "1"]),
@@ -493,6 +547,8 @@ def measure(groups, amalgam, tmp, demo_dir=None, qvc_dir=None, update_images=Fal
         values.update(yardstick_values())
     if "stamps" in groups:
         values.update(stamp_values())
+    if "volumetric" in groups:
+        values.update(volumetric_values())
     if "field" in groups:
         values.update(field_values(amalgam, tmp,
                                    ROOT / "docs/img/field.png" if update_images else None))
@@ -512,7 +568,8 @@ def main():
     ap.add_argument("mode", choices=["check", "update", "fill"])
     ap.add_argument("file", nargs="?")
     ap.add_argument("--amalgam", default=os.environ.get("AMALGAM", str(ROOT / "build/amalgam")))
-    ap.add_argument("--only", default="demo,experiments,counts,embree,field,paper,yardstick,stamps,pyexample,qvc")
+    ap.add_argument("--only", default="demo,experiments,counts,embree,field,paper,yardstick,stamps,"
+                                      "volumetric,pyexample,qvc")
     ap.add_argument("--demo-dir")
     ap.add_argument("--qvc-dir")
     ap.add_argument("--qvc-csv")
@@ -525,7 +582,7 @@ def main():
 
     groups = set(a.only.split(","))
     known = {"demo", "experiments", "counts", "embree", "field", "paper", "yardstick", "stamps",
-             "advise", "pyexample", "qvc"}
+             "volumetric", "advise", "pyexample", "qvc"}
     if not groups <= known:
         sys.exit(f"figures.py: unknown group {sorted(groups - known)}; known: {sorted(known)}")
     with tempfile.TemporaryDirectory() as tmp:
