@@ -3,14 +3,14 @@
 #
 #   scripts/bench.sh            full run (about 3 minutes on 2 cores) into out/bench/: results/
 #                               (Google Benchmark JSON, the field's results.json and images),
-#                               benchmarks.md and README.md (copies of the docs page and the
-#                               README with their generated tables rewritten); touches no docs
+#                               benchmarks.md and performance.md (copies of the docs pages
+#                               with their generated tables rewritten); touches no docs
 #   scripts/bench.sh --update-docs   the same into bench/results/, the tables in
-#                               docs/benchmarks.md and the README's speed section (between its
-#                               bench markers), every ratio from this one run
+#                               docs/benchmarks.md and the speed summary of docs/performance.md
+#                               (between its bench markers), every ratio from this one run
 #   scripts/bench.sh --quick    smoke run (smallest scenes, minimal time; seconds) of both
 #                               benchmarks and the report, in a temporary directory; touches
-#                               neither bench/results nor docs nor README.md
+#                               neither bench/results nor docs
 #
 # Environment: BUILD_DIR (default build, the release preset's directory),
 # AMALGAM_BENCH_MAX_TRIANGLES (default 1e7; 1e8 needs ~30 GB and is skipped by default).
@@ -25,9 +25,9 @@ esac
 QUICK=0
 [[ "$mode" == --quick ]] && QUICK=1
 if [[ "$mode" == --update-docs ]]; then
-  results=bench/results doc=docs/benchmarks.md readme=README.md
+  results=bench/results doc=docs/benchmarks.md summary=docs/performance.md
 else
-  results=out/bench/results doc=out/bench/benchmarks.md readme=out/bench/README.md
+  results=out/bench/results doc=out/bench/benchmarks.md summary=out/bench/performance.md
 fi
 
 if [[ "$BUILD_DIR" == build ]]; then
@@ -44,7 +44,7 @@ fi
 mkdir -p "$results"
 if [[ "$mode" != --update-docs ]]; then  # the generated parts are rewritten in copies
   cp docs/benchmarks.md "$doc"
-  cp README.md "$readme"
+  cp docs/performance.md "$summary"
 fi
 "$BUILD_DIR/bench/amalgam_embree_bench" --benchmark_out="$results/embree.json" \
   --benchmark_out_format=json 2> >(tee "$results/embree.log" >&2)
@@ -53,4 +53,4 @@ fi
 
 "$BUILD_DIR/bench/amalgam_field_bench" --out "$results/field"
 python3 scripts/bench_report.py "$results/embree.json" "$results/embree.log" \
-  "$results/field/results.json" "$doc" "$readme"
+  "$results/field/results.json" "$doc" "$summary"

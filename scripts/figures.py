@@ -21,13 +21,14 @@ Usage:
   figures.py fill FILE --qvc-csv CSV        (scripts/quality-vs-cost.sh: the figures of its page)
 
 Groups: demo (the four renders of scripts/demo.sh: 480x360, 4 spp, about 10 s),
-experiments (the names `amalgam experiment` takes), counts (the README's exact counts: a line
-traced, prisms rendered, about 5 s), embree (the pixels where --tracer embree differs from the
-traditional renderer; needs a build with Embree), field (docs/real-scenes.md: scenes/field.json
+experiments (the names `amalgam experiment` takes), counts (docs/exact-counts.md and
+docs/scene-format.md: a line traced, prisms rendered, the field loaded; about 5 s), embree
+(docs/guide.md: the pixels where --tracer embree differs from the traditional renderer; needs
+a build with Embree), field (docs/real-scenes.md: scenes/field.json
 at 1024x768 and its far band at 512x384; about 20 s; update also rewrites docs/img/field.png),
 paper (the verdict counts of docs/paper-reproduction.md, which
 scripts/plots/regenerate-docs.sh writes from `amalgam experiment all`), yardstick (the
-README's summary of the sections of docs/yardstick.md that scripts/yardstick.sh writes: best
+summary at the top of docs/yardstick.md of its sections that scripts/yardstick.sh writes: best
 speed-ups and commits), volumetric (the cost of `--renderer volumetric` that docs/volumetric.md
 quotes, read from docs/volumetric/results.md, which scripts/volumetric_eval.py writes; no
 render), stamps
@@ -132,7 +133,7 @@ def experiment_values(amalgam):
     return {"experiments.count": str(len(names))}
 
 
-# --- counts: the README's "Exact counts, measured" ----------------------------------------
+# --- counts: docs/exact-counts.md, "Exact counts, measured" --------------------------------
 
 def stats_of(amalgam, tmp, *args):
     out = subprocess.run([amalgam, "render", *args, "--out", str(tmp / "counts.png"),
@@ -221,8 +222,8 @@ def embree_values(amalgam, tmp):
 # --- paper: the verdicts of docs/paper-reproduction.md (written by regenerate-docs.sh) -------
 
 def paper_values():
-    """The README's summary of the report's verdict table: counts and the statements of each
-    verdict other than "holds"."""
+    """docs/exact-counts.md's summary of the report's verdict table: counts and the statements
+    of each verdict other than "holds"."""
     rows, inside = [], False
     for line in (ROOT / "docs/paper-reproduction.md").read_text().splitlines():
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
@@ -246,13 +247,13 @@ def paper_values():
     return v
 
 
-# --- yardstick: the README's summary of docs/yardstick.md (written by yardstick.sh) --------
+# --- yardstick: the summary at the top of docs/yardstick.md (its sections: yardstick.sh) ----
 
 # The page of the yardstick, one section per scene, each with its own generated part: between
 # the markers named after the section (scripts/yardstick_report.py --section NAME), or for the
 # field (street and aerial views) the unnamed ones (section None).
 YARDSTICK_DOC = "docs/yardstick.md"
-# README key: (section of YARDSTICK_DOC, view)
+# summary key: (section of YARDSTICK_DOC, view)
 YARDSTICK_PAGES = {"meadow": ("meadow", "street"),
                    "soft": ("soft", "aerial"),
                    "aerial": (None, "aerial"),
@@ -308,6 +309,10 @@ def yardstick_values():
 
 # --- stamps: a hand-written reading names the run it reads --------------------------------
 
+# The page whose speed summary scripts/bench.sh --update-docs writes (scripts/bench_report.py).
+BENCH_SUMMARY_DOC = "docs/performance.md"
+
+
 def stamp_values():
     """The commit or date of each generated run that a hand-written reading comments on. A
     reading carries the stamp of the run it was written from; when the run is regenerated,
@@ -318,8 +323,8 @@ def stamp_values():
     for key, section in (("yardstick", None), ("yardstick-meadow", "meadow"),
                          ("yardstick-soft", "soft")):
         v[f"stamps.{key}"] = yardstick_commit(section)
-    readme = (ROOT / "README.md").read_text()
-    block = readme[readme.index("<!-- bench:begin"):readme.index("<!-- bench:end")]
+    summary = (ROOT / BENCH_SUMMARY_DOC).read_text()
+    block = summary[summary.index("<!-- bench:begin"):summary.index("<!-- bench:end")]
     v["stamps.bench"] = re.search(r"date (\d{4}-\d\d-\d\d)", block).group(1)
     return v
 
