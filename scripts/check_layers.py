@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Checks the library's layering (README, "Layout"): every #include under src/amalgam points to
-the same layer or a lower one, the include graph has no cycle, a header compiled once per
-instruction set (AMALGAM_ISA_BEGIN, util/isa.h) is included in src/ only by such headers or by
-render/render_isa.inl (file and function lengths: check_sizes.py). Prints each violation and
-exits 1 if there is any.   Usage: check_layers.py [SOURCE_DIR]"""
+"""Checks the library's layering (docs/architecture.md, "Layers"): every #include under
+src/amalgam points to the same layer or a lower one, the include graph has no cycle, a header
+compiled once per instruction set (AMALGAM_ISA_BEGIN, util/isa.h) is included in src/ only by
+such headers or by render/render_isa.inl (file and function lengths: check_sizes.py). Prints
+each violation and exits 1 if there is any.   Usage: check_layers.py [SOURCE_DIR]"""
 import os
 import re
 import sys
