@@ -1,6 +1,6 @@
 // Outputs: never replace what is not ours (devices, FIFOs, the target of a symbolic link, not
 // the link), check every output before any work, refuse two outputs on one file; numbers out
-// of range are refused, not clamped (README, "Reliability").
+// of range are refused, not clamped (docs/reliability.md, "In short").
 
 #include <fcntl.h>
 #include <gtest/gtest.h>

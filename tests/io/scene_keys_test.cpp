@@ -1,4 +1,4 @@
-// The scene-file keys of the README whose effect is on geometry or the camera: `fit`,
+// The scene-file keys of docs/scene-format.md whose effect is on geometry or the camera: `fit`,
 // `subdivide`, `rotate_x_deg` / `rotate_y_deg` / `rotate_z_deg` and the camera's `up`. Each is
 // checked by what it does (bounds, triangle counts and areas, where the image shows a thing),
 // not only by parsing.

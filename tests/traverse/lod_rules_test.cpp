@@ -1,4 +1,4 @@
-// The LOD rules for a ray that starts inside an amalgam (README, design notes; traverse/lod.h,
+// The LOD rules for a ray that starts inside an amalgam (docs/architecture.md; traverse/lod.h,
 // traverse/state.h `renders`): under --footprint an amalgam that contains a ray's origin (a
 // shadow ray leaving a surface inside it) is descended, not rendered, because its opacity
 // describes rays that cross it; every other amalgam the ray meets is rendered as usual. Under

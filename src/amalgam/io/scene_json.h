@@ -1,6 +1,6 @@
 #pragma once
-/// \file Scene files (`.json`, schema in the README): the reader. What it produces is a
-/// SceneDescription (scene/description.h); bare meshes are loaded by load/load_scene.h.
+/// \file Scene files (`.json`, schema in docs/scene-format.md): the reader. What it produces is
+/// a SceneDescription (scene/description.h); bare meshes are loaded by load/load_scene.h.
 
 #include <cstdint>
 #include <functional>
