@@ -22,11 +22,10 @@ std::int64_t Params::get_int(const std::string& key, std::int64_t def, std::int6
   std::int64_t v = 0;
   auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
   if (ec != std::errc() || ptr != s.data() + s.size())
-    throw InputError(scene_ + ": --set " + key + "=" + s + ": expected an integer");
+    throw InputError(where(key, s) + ": expected an integer");
   if (v < lo || v > hi) {
     std::ostringstream m;
-    m << scene_ << ": --set " << key << "=" << s << ": expected an integer in [" << lo << ", " << hi
-      << "]";
+    m << where(key, s) << ": expected an integer in [" << lo << ", " << hi << "]";
     throw InputError(m.str());
   }
   return v;
@@ -44,12 +43,10 @@ double Params::get_double(const std::string& key, double def, double lo, double 
   } catch (const std::exception&) {
     pos = 0;
   }
-  if (pos != s.size() || !std::isfinite(v))
-    throw InputError(scene_ + ": --set " + key + "=" + s + ": expected a number");
+  if (pos != s.size() || !std::isfinite(v)) throw InputError(where(key, s) + ": expected a number");
   if (v < lo || v > hi) {
     std::ostringstream m;
-    m << scene_ << ": --set " << key << "=" << s << ": expected a number in [" << lo << ", " << hi
-      << "]";
+    m << where(key, s) << ": expected a number in [" << lo << ", " << hi << "]";
     throw InputError(m.str());
   }
   return v;
@@ -63,14 +60,26 @@ std::string Params::get_choice(const std::string& key, const std::string& def,
   if (!allowed.count(it->second)) {
     std::string list;
     for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-    throw InputError(scene_ + ": --set " + key + "=" + it->second + ": expected one of " + list);
+    throw InputError(where(key, it->second) + ": expected one of " + list);
   }
   return it->second;
 }
 
+std::string Params::where(const std::string& key, const std::string& value) const {
+  return scene_ + (spelling_ == ParamSpelling::kSet ? ": --set " : ": ") + key + "=" + value;
+}
+
 void Params::check_all_used() const {
-  for (const auto& [k, v] : values_)
-    if (!used_.count(k)) throw InputError(scene_ + ": unknown parameter '" + k + "' in --set");
+  for (const auto& [k, v] : values_) {
+    if (used_.count(k)) continue;
+    if (spelling_ == ParamSpelling::kSet)
+      throw UnknownParameter(scene_ + ": unknown parameter '" + k + "' in --set");
+    std::string known;
+    for (const auto& u : used_) known += (known.empty() ? "" : ", ") + u;
+    throw UnknownParameter("load() got an unexpected keyword argument '" + k + "' (" + scene_ +
+                           (known.empty() ? " takes no parameters" : "'s parameters: " + known) +
+                           ")");
+  }
 }
 
 std::string Params::applied() const {

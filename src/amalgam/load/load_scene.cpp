@@ -7,6 +7,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 
 #include "amalgam/io/json_reader.h"
 #include "amalgam/io/mesh_import.h"
@@ -84,21 +85,20 @@ double resident_bytes() {
   return resident * static_cast<double>(sysconf(_SC_PAGE_SIZE));
 }
 
-}  // namespace
-
-LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config) {
+/// Reads a scene with `read` and builds and bakes it: the work of load_scene_path, for a file
+/// (`path` its name, and the first of the inputs) or for text (`path` names it in messages).
+LoadedScene load_read(const std::string& path, bool is_file, const SceneFileConfig& config,
+                      const std::function<SceneDescription()>& read) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   if (config.on_phase) config.on_phase("reading " + path);
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  SceneDescription d = ext == ".json" ? read_scene_json(path, config) : mesh_scene(path, config);
+  SceneDescription d = read();
   const auto t1 = Clock::now();
   Environment env = std::move(d.env);
   std::vector<NamedCamera> cameras = std::move(d.cameras);
   std::vector<std::string> warnings = std::move(d.warnings);
-  std::vector<std::string> inputs = {path};
+  std::vector<std::string> inputs;
+  if (is_file) inputs.push_back(path);
   inputs.insert(inputs.end(), d.inputs.begin(), d.inputs.end());
   const bool defaults = d.default_lights, framed = d.framed_camera;
   if (config.on_phase) config.on_phase("building and baking " + path);
@@ -152,6 +152,22 @@ LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& conf
   s.amalgams = config.amalgams;
   s.build_seconds = std::max(0.0, std::chrono::duration<double>(t2 - t1).count() - bake_seconds);
   return s;
+}
+
+}  // namespace
+
+LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return load_read(path, true, config, [&] {
+    return ext == ".json" ? read_scene_json(path, config) : mesh_scene(path, config);
+  });
+}
+
+LoadedScene load_scene_text(const std::string& text, const std::string& name,
+                            const SceneFileConfig& config) {
+  return load_read(name, false, config, [&] { return parse_scene_json(text, name, config); });
 }
 
 namespace {

@@ -28,6 +28,12 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
 /// bake_seconds (the bake apart from the rest of the build).
 LoadedScene load_scene_path(const std::string& path, const SceneFileConfig& config = {});
 
+/// Loads scene-file text (the JSON of a `.json` scene; io/scene_json.h) as load_scene_path
+/// loads a file: `name` names it in messages (e.g. "the dict"). Relative mesh paths resolve
+/// against the current directory, unless `name` has a folder. Its inputs are the files it reads.
+LoadedScene load_scene_text(const std::string& text, const std::string& name,
+                            const SceneFileConfig& config = {});
+
 /// The view asked for on the command line: one of the scene file's cameras (glTF) by name or
 /// index, then any of its fields replaced; and the shadow rays per sized light.
 struct CameraChoice {
