@@ -1,7 +1,7 @@
 #pragma once
-/// \file What the Python module's bindings (amalgam_module.cpp) are built from: an integer
-/// argument that refuses bools, NumPy views of the library's vectors, checked render options,
-/// the converted result of a render, and the view keywords (the CLI's --eye, --fov, ...).
+/// \file What the Python module's bindings (amalgam_module.cpp, scene.cpp) are built from:
+/// NumPy views of the library's vectors, checked render options, the converted result of a
+/// render, and the view keywords (the CLI's --eye, --fov, ...).
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -17,31 +17,6 @@
 #include "amalgam/render/render.h"
 
 namespace py = pybind11;
-
-/// An integer argument that refuses True and False: Python's bool is an int, so width=True
-/// would otherwise render one pixel wide. A bool is then a TypeError, as a float is.
-template <class T>
-struct Strict {
-  T value{};
-  operator T() const { return value; }  // NOLINT: used where the plain integer is
-};
-
-namespace pybind11::detail {
-template <class T>
-struct type_caster<Strict<T>> {
-  PYBIND11_TYPE_CASTER(Strict<T>, const_name("int"));
-  bool load(handle src, bool convert) {
-    if (PyBool_Check(src.ptr())) return false;
-    make_caster<T> plain;
-    if (!plain.load(src, convert)) return false;
-    value.value = cast_op<T>(plain);
-    return true;
-  }
-  static handle cast(Strict<T> v, return_value_policy policy, handle parent) {
-    return make_caster<T>::cast(v.value, policy, parent);
-  }
-};
-}  // namespace pybind11::detail
 
 namespace amalgam::python {
 
@@ -97,5 +72,8 @@ Vec3 view_vec(const py::handle& v, const std::string& option);
 /// One view keyword (camera=, eye=, look_at=, up=, fov=: the CLI's --camera, --eye, --look-at,
 /// --up, --fov) into `view`; false when `key` is not one of them.
 bool view_keyword(const std::string& key, const py::handle& value, CameraChoice& view);
+
+/// Defines `amalgam.load` and `amalgam.Scene` (scene.cpp) in `m`.
+void bind_scene(py::module_& m);
 
 }  // namespace amalgam::python

@@ -1,6 +1,7 @@
 """Errors: ValueError for bad input with the CLI's one-line message; KeyboardInterrupt."""
 
 import os
+import pydoc
 import signal
 import subprocess
 import threading
@@ -25,12 +26,16 @@ def test_unknown_builtin_is_value_error(cli, tmp_path):
     assert str(e.value) == message
 
 
-def test_unknown_parameter_is_value_error(cli, tmp_path):
-    message, _ = cli_message(cli, "render", "builtin:demo", "--set", "bogus=1", "--out",
-                             str(tmp_path / "x.pfm"))
-    with pytest.raises(ValueError) as e:
+def test_unknown_parameter_is_type_error(cli, tmp_path):
+    # The CLI names its --set; Python raises what it raises for any unexpected keyword
+    # argument, listing the parameters the builtin has.
+    message, status = cli_message(cli, "render", "builtin:demo", "--set", "bogus=1", "--out",
+                                  str(tmp_path / "x.pfm"))
+    assert status == 2 and message == "builtin:demo: unknown parameter 'bogus' in --set"
+    with pytest.raises(TypeError) as e:
         amalgam.load("builtin:demo", bogus=1)
-    assert str(e.value) == message
+    assert str(e.value) == ("load() got an unexpected keyword argument 'bogus' "
+                            "(builtin:demo's parameters: depth, fill, leaf, lights, split, view)")
 
 
 def test_level_beyond_lmax_is_value_error(cli, demo, tmp_path):
@@ -125,7 +130,9 @@ def test_help_shows_the_api():
     doc = amalgam.__doc__
     assert "load" in doc and "render" in doc
     assert "KeyboardInterrupt" in amalgam.Scene.render.__doc__
-    assert amalgam.load.__doc__.startswith("load(")
+    # help() shows each function's signature (its text signature) above its docstring.
+    assert pydoc.render_doc(amalgam.load, renderer=pydoc.plaintext).count("load(scene, *, camera=None") == 1
+    assert "render(self, /, *, width=512" in pydoc.render_doc(amalgam.Scene, renderer=pydoc.plaintext)
 
 
 def test_bad_view_keywords_are_value_errors(cli, tmp_path):
