@@ -1,9 +1,13 @@
 """Type stub of the amalgam module (python/amalgam_module.cpp; docs/python.md)."""
 
+import os
 from typing import Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
+
+# A path argument: str, bytes or os.PathLike (pathlib.Path), as open() takes it.
+_StrPath = Union[str, bytes, os.PathLike[str], os.PathLike[bytes]]
 
 __version__: str
 has_embree: bool  # whether tracer="embree" is available in this build
@@ -25,8 +29,13 @@ class RenderResult:
     spp_requested: int
     interrupted: bool
     seconds: float
-    def save(self, path: str) -> None:
+    def save(self, path: _StrPath) -> None:
         """Writes the image as `render --out` does: .png (8-bit sRGB), .exr or .pfm."""
+    def __array__(
+        self, dtype: Optional[npt.DTypeLike] = None, copy: Optional[bool] = None
+    ) -> npt.NDArray[Any]:
+        """numpy.asarray(result): the image itself (no copy) unless dtype or copy=True ask
+        for one; copy=False raises ValueError where a copy is needed."""
 
 class Scene:
     """A loaded scene: its built, baked hierarchy, reused by every render."""
@@ -41,6 +50,7 @@ class Scene:
     def warnings(self) -> list[str]: ...
     def render(
         self,
+        /,
         *,
         width: int = 512,
         height: int = 512,
@@ -66,6 +76,7 @@ class Scene:
         render only, from the view `load` chose); KeyboardInterrupt carries `.partial`."""
     def trace(
         self,
+        /,
         origin: Optional[Sequence[float]] = None,
         direction: Optional[Sequence[float]] = None,
         *,
@@ -82,21 +93,24 @@ class Scene:
         """One primary ray with its shadow rays: 'hit', 'colour' and the counts."""
 
 def load(
-    scene: str,
+    scene: Union[_StrPath, dict[str, Any]],  # a path, "builtin:NAME", or a scene dict
     *,
     camera: Union[str, int] = ...,
     eye: Sequence[float] = ...,
     look_at: Sequence[float] = ...,
     up: Sequence[float] = ...,
     fov: float = ...,
+    light_samples: int = ...,  # --light-samples
     volumetric: bool = ...,  # --renderer volumetric: objects with their cells baked
     smooth_normals: bool = ...,  # --smooth-normals
     **params: Union[int, float, str],
 ) -> Scene:
-    """'builtin:NAME' with parameters as keywords, a scene .json, or a mesh path; the view
-    keywords are the CLI's --camera, --eye, --look-at, --up, --fov."""
+    """'builtin:NAME' with parameters as keywords, a scene .json or a mesh path, or a dict
+    holding what a scene .json holds (relative mesh paths: from the current directory); the
+    view keywords are the CLI's --camera, --eye, --look-at, --up, --fov. An unknown keyword
+    is TypeError, a bad value ValueError."""
 
-def save_image(path: str, image: Union[RenderResult, npt.ArrayLike]) -> None:
+def save_image(path: _StrPath, image: Union[RenderResult, npt.ArrayLike]) -> None:
     """Writes H x W x 3 linear RGB as `render --out` does, by extension: .png, .exr, .pfm."""
 
 def to_srgb(image: Union[RenderResult, npt.ArrayLike]) -> npt.NDArray[np.uint8]:
