@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "advise.h"
 #include "amalgam/io/colormap.h"
 #include "amalgam/io/image.h"
 #include "amalgam/io/legend.h"
@@ -28,30 +29,8 @@
 namespace amalgam::cli {
 namespace {
 
-/// One renderer advise compares.
-struct Candidate {
-  std::string name;  ///< as the table and the strip name it
-  std::string key;   ///< as the JSON and --keep name it
-  RenderOptions options;
-};
-
-struct Measured {
-  Candidate c;
-  RenderOutput out;
-  double setup_s = 0;  ///< what this renderer needs beyond reading the scene
-  double rmse = 0;
-  double efficiency = 0;  ///< 1 / (MSE x render seconds), relative to full detail
-};
-
-double mse(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
-  double s = 0;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    for (int k = 0; k < 3; ++k) {
-      const double d = static_cast<double>(a[i][k]) - b[i][k];
-      s += d * d;
-    }
-  return s / (3.0 * static_cast<double>(a.size()));
-}
+using advise::Candidate;
+using advise::Measured;
 
 std::string fixed(double v, int digits) {
   char buf[64];
@@ -59,34 +38,9 @@ std::string fixed(double v, int digits) {
   return buf;
 }
 
-std::vector<Candidate> candidates(const RenderOptions& base) {
-  std::vector<Candidate> out;
-  RenderOptions o = base;
-  o.lod = FullDetail{};
-  out.push_back({"full detail", "traditional", o});
-  if (have_embree()) {
-    o.tracer = TracerKind::kEmbree;
-    out.push_back({"Embree, full detail", "embree", o});
-    o.tracer = TracerKind::kAmalgam;
-  }
-  for (float k : {1.0f, 4.0f}) {
-    o.lod = ByFootprint{k};
-    o.opacity = OpacityKind::kStochastic;
-    out.push_back({"amalgams K=" + fixed(k, 0) + ", stochastic",
-                   "scale-sensitive-k" + fixed(k, 0) + "-stochastic", o});
-  }
-  o.lod = ByFootprint{1.0f};
-  o.opacity = OpacityKind::kComposite;
-  out.push_back({"amalgams K=1, composite", "scale-sensitive-k1-composite", o});
-  return out;
-}
-
-/// Render seconds per sample of `tracer` at `o`'s size: the mean of an 8-sample render (half
-/// the default budget for full detail: shorter pilots misjudge by 20-30 % at 320x240).
-double seconds_per_sample(const Tracer& tracer, RenderOptions o) {
-  o.spp = 8;
-  return tracer.render(o).seconds / 8;
-}
+/// Renders under this many seconds each are timed too coarsely to compare (the default time
+/// is at least this).
+constexpr double kMinSeconds = 0.5;
 
 // --- the strip -------------------------------------------------------------------------------
 
@@ -137,8 +91,8 @@ Canvas strip(const RenderOutput& ref, const std::vector<Measured>& ms, int max_l
     const Measured& m = ms[j];
     const bool counted = m.c.options.tracer == TracerKind::kAmalgam;
     column(static_cast<int>(j) + 1, m.c.name, m.out,
-           std::to_string(m.out.spp) + " spp, " + fixed(m.out.seconds, 2) + " s",
-           "RMSE " + fixed(m.rmse, 4) + ", " + fixed(m.efficiency, 2) + "x", counted,
+           std::to_string(m.out.spp) + " spp, " + fixed(m.seconds(), 2) + " s",
+           "RMSE " + fixed(m.rmse(), 4) + ", " + fixed(m.vs_full.value, 2) + "x", counted,
            m.c.options.renderer() == RendererKind::kScaleSensitive);
   }
   // The legends: the cost bar across the strip, then the levels.
@@ -165,7 +119,7 @@ std::vector<OutputFile> advise_outputs(const AdviseOptions& a, const RenderOptio
   if (!a.keep.empty()) {
     const std::filesystem::path dir(a.keep);
     outs.push_back({"--keep", (dir / "reference.pfm").string()});
-    for (const Candidate& c : candidates(base))
+    for (const Candidate& c : advise::candidates(base))
       outs.push_back({"--keep", (dir / (c.key + ".pfm")).string()});
   }
   return outs;
@@ -179,7 +133,7 @@ void check_advise_outputs(const AdviseOptions& a, const CommonOptions& common) {
     throw InputError("--out " + a.out + ": the strip is a PNG (.png)");
   RenderOptions film = common.options;
   film.width = a.width, film.height = a.height;
-  const std::size_t films = 1 + candidates(common.options).size();  // all held at once
+  const std::size_t films = 1 + advise::candidates(common.options).size();  // all held at once
   const double bytes = static_cast<double>(film_bytes(film)) * static_cast<double>(films);
   if (bytes > static_cast<double>(physical_memory()))
     throw InputError("--width " + std::to_string(a.width) + " --height " +
@@ -191,66 +145,6 @@ void check_advise_outputs(const AdviseOptions& a, const CommonOptions& common) {
     make_output_dir("--keep", a.keep, advise_outputs(a, common.options), common.scene);
 }
 
-/// Each candidate rendered for `budget` seconds of rendering, its RMSE against `ref`, and
-/// full detail's MSE x time over its own.
-std::vector<Measured> measure(const LoadedScene& scene, const RenderOptions& base,
-                              const RenderOutput& ref, double budget) {
-  std::vector<Measured> ms;
-  for (const Candidate& c : candidates(base)) {
-    set_activity("rendering with " + c.name);
-    const std::unique_ptr<Tracer> tracer = make_tracer(scene, c.options);
-    Measured m{c, {}, 0, 0, 0};
-    m.setup_s = scene.build_seconds + tracer->build_seconds() +
-                (c.options.renderer() == RendererKind::kTraditional ? 0.0 : scene.bake_seconds);
-    const double per_sample = seconds_per_sample(*tracer, c.options);
-    m.c.options.spp =
-        static_cast<int>(std::clamp(std::floor(budget / std::max(per_sample, 1e-9)), 1.0, 65536.0));
-    m.out = tracer->render(m.c.options);
-    m.rmse = std::sqrt(mse(m.out.image, ref.image));
-    ms.push_back(std::move(m));
-  }
-  // Error x time relative to full detail: above 1, lower error in the same time.
-  const double base_cost = ms[0].rmse * ms[0].rmse * ms[0].out.seconds;
-  for (Measured& m : ms) m.efficiency = base_cost / (m.rmse * m.rmse * m.out.seconds);
-  return ms;
-}
-
-/// The table and the verdict; returns the best level-of-detail renderer.
-const Measured& report(std::ostream& log, const std::vector<Measured>& ms, double budget,
-                       const AdviseOptions& a) {
-  log << "time per renderer: " << fixed(budget, 3) << " s of rendering; " << a.width << "x"
-      << a.height << ", stratified\n\n";
-  char row[256];
-  std::snprintf(row, sizeof row, "%-30s %6s %9s %9s %10s %9s %12s\n", "renderer", "spp", "render s",
-                "setup s", "tests/ray", "RMSE", "vs full det.");
-  log << row;
-  for (const Measured& m : ms) {
-    const std::string tests = m.c.options.tracer == TracerKind::kAmalgam
-                                  ? fixed(m.out.per_primary.mean(), 1)
-                                  : std::string("-");
-    std::snprintf(row, sizeof row, "%-30s %6d %9.3f %9.3f %10s %9.5f %11.2fx\n", m.c.name.c_str(),
-                  m.out.spp, m.out.seconds, m.setup_s, tests.c_str(), m.rmse, m.efficiency);
-    log << row;
-  }
-  const auto best =
-      std::max_element(ms.begin(), ms.end(), [](const Measured& x, const Measured& y) {
-        const bool ax = x.c.options.renderer() == RendererKind::kScaleSensitive;
-        const bool ay = y.c.options.renderer() == RendererKind::kScaleSensitive;
-        return ax != ay ? ay : x.efficiency < y.efficiency;
-      });
-  log << "\n\"vs full det.\": full detail's MSE x time over this renderer's (above 1: lower "
-         "error in the same time).\n";
-  const double e = best->efficiency;
-  log << (e > 1.1   ? "Amalgams pay off on this view: "
-          : e < 0.9 ? "Amalgams do not pay off on this view: "
-                    : "Amalgams about break even on this view: ")
-      << "the best, " << best->c.name << ", has " << fixed(e, 2)
-      << "x full detail's error-per-time";
-  if (have_embree()) log << " (Embree: " << fixed(ms[1].efficiency, 2) << "x)";
-  log << ".\n";
-  return *best;
-}
-
 /// Every image and the reference as PFM in --keep's directory, named by key.
 void keep_images(const AdviseOptions& a, const RenderOutput& ref, const std::vector<Measured>& ms) {
   std::filesystem::create_directories(a.keep);
@@ -259,34 +153,6 @@ void keep_images(const AdviseOptions& a, const RenderOutput& ref, const std::vec
   for (const Measured& m : ms)
     write_image((std::filesystem::path(a.keep) / (m.c.key + ".pfm")).string(), m.out.width,
                 m.out.height, m.out.image);
-}
-
-/// The table as JSON (--json FILE or -).
-void write_json(const AdviseOptions& a, const std::string& scene, double budget,
-                const RenderOutput& ref, const std::vector<Measured>& ms, const Measured& best) {
-  nlohmann::ordered_json j;
-  j["scene"] = scene;
-  j["width"] = a.width, j["height"] = a.height;
-  j["render_seconds_each"] = budget;
-  j["reference"] = {{"spp", a.reference_spp}, {"seconds", ref.seconds}};
-  for (const Measured& m : ms) {
-    nlohmann::ordered_json r;
-    r["name"] = m.c.name;
-    r["key"] = m.c.key;
-    r["spp"] = m.out.spp;
-    r["render_seconds"] = m.out.seconds;
-    r["setup_seconds"] = m.setup_s;
-    if (m.c.options.tracer == TracerKind::kAmalgam)
-      r["tests_per_primary_ray"] = m.out.per_primary.mean();
-    r["rmse"] = m.rmse;
-    r["vs_full_detail"] = m.efficiency;
-    j["renderers"].push_back(r);
-  }
-  j["best_level_of_detail"] = best.c.key;
-  if (a.json == "-")
-    std::cout << j.dump(2) << "\n";
-  else
-    write_file_atomic(a.json, j.dump(2) + "\n");
 }
 
 }  // namespace
@@ -301,6 +167,16 @@ int run_advise(CommonOptions& common, const AdviseOptions& a) {
   check_files_spare_inputs(advise_outputs(a, common.options), scene);
   common.prepare(scene);
   print_warnings(scene);
+  const double scene_bytes = advise::resident_bytes();
+  advise::Scenes scenes{&scene, nullptr, 0};
+  if (!scene.inputs.empty()) {  // a scene file or mesh: its objects for the volumetric renderer
+    set_activity("loading the objects of " + common.scene + " for the volumetric renderer");
+    config.objects = true, config.amalgams = false;
+    auto objects = std::make_shared<LoadedScene>(load_scene(common.scene, common.params(), config));
+    common.prepare(*objects);
+    scenes.objects_bytes = std::max(0.0, advise::resident_bytes() - scene_bytes);
+    if (objects->volumes) scenes.objects = std::move(objects);
+  }
 
   RenderOptions base = common.options;
   base.width = a.width, base.height = a.height;
@@ -316,22 +192,25 @@ int run_advise(CommonOptions& common, const AdviseOptions& a) {
   const RenderOutput ref = full->render(ref_options);
   log << "reference: full detail, " << a.reference_spp << " spp (stratified), "
       << fixed(ref.seconds, 2) << " s\n";
+  if (!scenes.objects) log << "volumetric cells: not compared (the scene has no meshes)\n";
   double budget = a.seconds;
   if (budget <= 0) {
     RenderOptions o = base;
     o.lod = FullDetail{}, o.spp = 16;
-    budget = full->render(o).seconds;
+    budget = std::max(full->render(o).seconds, kMinSeconds);
   }
 
-  const std::vector<Measured> ms = measure(scene, base, ref, budget);
-  const Measured& best = report(log, ms, budget, a);
+  const std::vector<Measured> ms = advise::measure(scenes, base, ref, budget, a.repeats);
+  const advise::Verdict v = advise::judge(ms);
+  advise::report(log, ms, v, budget, a.repeats, a);
   if (!a.keep.empty()) keep_images(a, ref, ms);
   if (!a.out.empty()) {
     const Canvas c = strip(ref, ms, scene.info().levels - 1, a.reference_spp);
     write_image(a.out, c.width, c.height, c.pixels);
     log << "strip: " << a.out << "\n";
   }
-  if (!a.json.empty()) write_json(a, common.scene, budget, ref, ms, best);
+  if (!a.json.empty())
+    advise::write_json(a, common.scene, budget, a.repeats, ref, ms, v, scene_bytes);
   return 0;
 }
 

@@ -94,6 +94,7 @@ Vec3 parse_vec3(const std::string& text, const std::string& option);
 struct RenderExtras {
   std::string out, stats, cost_image, checkpoint;
   std::string level_image;        ///< --level-image PATH
+  std::string cost_legend;        ///< --cost-legend PATH: the cost PNG's bar apart
   std::string cost_range;         ///< --cost-range MIN,MAX as given; empty: the image's own
   std::vector<std::string> argv;  ///< the whole command line, for the stats and EXR header
   bool resume = false;
@@ -115,7 +116,8 @@ int run_experiment(const std::string& name, const std::string& out_dir, bool qui
 /// The options of `advise` beyond the scene and view ones (docs/cli.md).
 struct AdviseOptions {
   int width = 320, height = 240;
-  double seconds = 0;       ///< time per renderer; 0: that of full detail at 16 spp
+  double seconds = 0;       ///< time per render; 0: that of full detail at 16 spp, >= 0.5 s
+  int repeats = 3;          ///< renders per renderer, interleaved: the ratios' intervals
   int reference_spp = 256;  ///< the converged estimate's samples (full detail, stratified)
   std::string out;          ///< the strip PNG; empty: none
   std::string json;         ///< the table as JSON (- for stdout); empty: none

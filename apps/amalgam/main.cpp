@@ -64,6 +64,9 @@ void add_render(CLI::App& app, Commands& c, int argc, char** argv) {
   c.render->add_option(
       "--cost-image", c.extras.cost_image,
       "write intersection tests per pixel: false colour (.png) or raw (.exr/.pfm)");
+  c.render->add_option("--cost-legend", c.extras.cost_legend,
+                       "write the cost PNG's colour bar to this PNG instead of below the "
+                       "picture, so that the cost PNG is the image's size and overlays it");
   c.render->add_option("--cost-range", c.extras.cost_range,
                        "MIN,MAX: the log scale of the cost PNG, in tests per primary sample "
                        "(default: the image's own range)");
@@ -176,9 +179,15 @@ void add_advise(CLI::App& app, Commands& c) {
   c.advise->add_option("--height", c.adv.height, "image height (default 240)")
       ->check(cli::positive_int());
   c.advise
-      ->add_option("--time", c.adv.seconds,
-                   "render seconds per renderer (default: what full detail takes for 16 spp)")
+      ->add_option(
+          "--time", c.adv.seconds,
+          "render seconds per render (default: what full detail takes for 16 spp, at least 0.5)")
       ->check(cli::seconds_in(1e-3, 86400, "[0.001, 86400]"));
+  c.advise
+      ->add_option("--repeats", c.adv.repeats,
+                   "renders per renderer, in rounds, for the 95 % intervals of the ratios "
+                   "(default 3; 1: no interval)")
+      ->check(CLI::Range(1, 20));
   c.advise
       ->add_option("--reference-spp", c.adv.reference_spp,
                    "samples per pixel of the converged full-detail estimate (default 256)")

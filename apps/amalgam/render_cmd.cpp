@@ -207,7 +207,8 @@ bool write_outputs(const CommonOptions& common, const RenderExtras& extra, const
       }
     });
     if (!extra.cost_image.empty())
-      attempt(extra.cost_image, [&] { write_cost_image(extra.cost_image, r, range); });
+      attempt(extra.cost_image,
+              [&] { write_cost_image(extra.cost_image, r, range, extra.cost_legend); });
     if (!extra.level_image.empty())
       attempt(extra.level_image, [&] { write_level_image(extra.level_image, r, max_level); });
   }
@@ -258,7 +259,10 @@ void finish_complete(const RenderExtras& extra, const std::string& ckpt, const P
     std::cerr << r.per_primary.mean() << " tests per primary ray)\n";
   if (!extra.cost_image.empty() && is_png_path(extra.cost_image))
     std::cerr << "amalgam: cost image " << extra.cost_image << ": viridis, log scale "
-              << format_range(range) << " tests per primary sample (colour bar along the bottom)\n";
+              << format_range(range) << " tests per primary sample (colour bar "
+              << (extra.cost_legend.empty() ? std::string("along the bottom")
+                                            : "in " + extra.cost_legend)
+              << ")\n";
   if (!extra.level_image.empty() && is_png_path(extra.level_image))
     std::cerr << "amalgam: level image " << extra.level_image << ": viridis from level 0 to "
               << p.loaded->info().levels - 1 << "; light grey: primitives; black: nothing hit\n";

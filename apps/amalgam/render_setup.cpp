@@ -9,6 +9,7 @@
 
 #include "amalgam/hierarchy/build/build.h"
 #include "amalgam/io/image.h"
+#include "amalgam/io/render_outputs.h"
 #include "amalgam/util/atomic_file.h"
 #include "amalgam/util/file_kind.h"
 
@@ -19,6 +20,7 @@ namespace {
 std::vector<OutputFile> outputs(const RenderExtras& e, const std::string& ckpt) {
   return {{"--out", e.out},
           {"--cost-image", e.cost_image},
+          {"--cost-legend", e.cost_legend},
           {"--level-image", e.level_image},
           {"--stats", e.stats},
           {"--checkpoint", ckpt}};
@@ -90,6 +92,9 @@ void check_outputs(const RenderExtras& e, const std::string& ckpt, const RenderO
   if (!e.cost_image.empty() && !is_image_path(e.cost_image))
     throw InputError("--cost-image " + e.cost_image +
                      ": unsupported image format (expected .png, .exr or .pfm)");
+  if (!e.cost_legend.empty() && (!is_png_path(e.cost_legend) || !is_png_path(e.cost_image)))
+    throw InputError("--cost-legend " + e.cost_legend +
+                     ": the colour bar of a PNG --cost-image, itself a PNG (.png)");
   if (!e.level_image.empty() && !is_image_path(e.level_image))
     throw InputError("--level-image " + e.level_image +
                      ": unsupported image format (expected .png, .exr or .pfm)");

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "amalgam/io/image.h"
@@ -44,7 +45,7 @@ TEST(Advise, MeasuresEveryRendererAgainstAConvergedEstimate) {
   const fs::path d = scratch_dir("amalgam-advise");
   const std::string args =
       "advise builtin:prisms --set depth=5 --width 64 --height 48 "
-      "--reference-spp 32 --time 0.02 --threads 2 --keep " +
+      "--reference-spp 32 --time 0.02 --repeats 1 --threads 2 --keep " +
       (d / "keep").string() + " --out " + (d / "strip.png").string() + " --json " +
       (d / "a.json").string();
   const test::CommandResult r = amalgam_cli(args);
@@ -144,6 +145,72 @@ TEST(Advise, AnOutputNeverReplacesAnInputOrAnotherOutput) {
   EXPECT_EQ(test::slurp(png), png_bytes);
   EXPECT_EQ(test::slurp(pfm), pfm_bytes);
   EXPECT_FALSE(fs::exists(strip));
+}
+
+/// exp(mean -+ t * sd / sqrt(n)) of `logs`: the interval advise documents (Student's t, 95 %).
+std::pair<double, double> interval(const std::vector<double>& logs) {
+  const double t[] = {0, 12.706, 4.303, 3.182, 2.776, 2.571};
+  const double n = static_cast<double>(logs.size());
+  double mean = 0, var = 0;
+  for (double l : logs) mean += l / n;
+  for (double l : logs) var += (l - mean) * (l - mean) / (n - 1);
+  const double half = t[logs.size() - 1] * std::sqrt(var / n);
+  return {std::exp(mean - half), std::exp(mean + half)};
+}
+
+// On a close-up (a Wuson filling the view: amalgams render little but full detail), each ratio
+// and interval is what the repeats' own errors and times give, the best named has the best
+// ratio, and every renderer it is not tied with is slower beyond the interval: advise never
+// names as best a renderer slower than another by more than the noise.
+TEST(Advise, NamesABestOnlyBeyondTheIntervalsOfTheRepeats) {
+  const fs::path d = scratch_dir("amalgam-advise-repeats");
+  const test::CommandResult r = amalgam_cli(
+      "advise /usr/share/assimp/models/PLY/Wuson.ply --width 48 --height 36 --reference-spp 16 "
+      "--time 0.03 --repeats 4 --threads 2 --json " +
+      (d / "a.json").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(slurp(d / "a.json"));
+  const auto& rs = j["renderers"];
+  ASSERT_EQ(rs.size(), have_embree() ? 6u : 5u) << "the volumetric renderer is compared";
+  EXPECT_EQ(rs.back()["key"], "volumetric");
+  auto costs = [&](const nlohmann::json& m) {
+    std::vector<double> c;
+    for (const auto& run : m["runs"])
+      c.push_back(
+          std::log(std::pow(run["rmse"].get<double>(), 2) * run["render_seconds"].get<double>()));
+    return c;
+  };
+  auto log_ratio = [&](const nlohmann::json& a, const nlohmann::json& b) {
+    std::vector<double> out, x = costs(a), y = costs(b);
+    for (std::size_t k = 0; k < x.size(); ++k) out.push_back(x[k] - y[k]);
+    return out;
+  };
+  std::size_t best = 0;
+  for (std::size_t i = 0; i < rs.size(); ++i) {
+    ASSERT_EQ(rs[i]["runs"].size(), 4u);
+    const auto [lo, hi] = interval(log_ratio(rs[0], rs[i]));
+    EXPECT_NEAR(rs[i]["vs_full_detail_low"].get<double>(), lo, 1e-9 * lo);
+    EXPECT_NEAR(rs[i]["vs_full_detail_high"].get<double>(), hi, 1e-9 * hi);
+    EXPECT_NEAR(rs[i]["vs_full_detail"].get<double>(), std::sqrt(lo * hi), 1e-9 * hi);
+    if (rs[i]["vs_full_detail"].get<double>() > rs[best]["vs_full_detail"].get<double>()) best = i;
+  }
+  ASSERT_EQ(j["best"], rs[best]["key"]) << r.out;
+  std::vector<std::string> tied;
+  for (const auto& k : j.value("tied_with_best", nlohmann::json::array())) tied.push_back(k);
+  for (std::size_t i = 0; i < rs.size(); ++i) {
+    if (i == best) continue;
+    const bool is_tied = std::find(tied.begin(), tied.end(), rs[i]["key"]) != tied.end();
+    // Its cost over the best's: tied exactly when the interval reaches 1.
+    EXPECT_EQ(is_tied, interval(log_ratio(rs[i], rs[best])).first <= 1.0) << rs[i]["key"];
+  }
+  const auto& q = j["level_of_detail_vs_full_detail"];
+  const std::string verdict = j["verdict"];
+  EXPECT_EQ(verdict, q["low"].get<double>() > 1    ? "pays off"
+                     : q["high"].get<double>() < 1 ? "does not pay off"
+                                                   : "undecided");
+  EXPECT_NE(r.out.find("Best error per time on this view: " + rs[best]["name"].get<std::string>()),
+            std::string::npos)
+      << r.out;
 }
 
 }  // namespace advise_test

@@ -385,5 +385,40 @@ TEST(RenderOutputs, LevelPngIsColourCodedWithItsLegendPrinted) {
   EXPECT_GT(black, 0);
 }
 
+// With --cost-legend the cost PNG is the film's size, its pixels those of the picture above the
+// bar without it (so it overlays the image), and the bar with its numbers is a PNG of its own.
+TEST(RenderOutputs, CostLegendApartLeavesACostPngOfTheImagesSize) {
+  const fs::path d = temp_dir();
+  const std::string a =
+      "render builtin:prisms --set depth=4 --width 40 --height 30 --spp 1 "
+      "--quiet --cost-range 1,300 --out ";
+  ASSERT_EQ(
+      amalgam(a + (d / "l.png").string() + " --cost-image " + (d / "with_bar.png").string()).status,
+      0);
+  ASSERT_EQ(amalgam(a + (d / "l2.png").string() + " --cost-image " + (d / "apart.png").string() +
+                    " --cost-legend " + (d / "bar.png").string())
+                .status,
+            0);
+  int w = 0, h = 0, bw = 0, bh = 0, lw = 0, lh = 0;
+  const auto apart = amalgam::read_image((d / "apart.png").string(), w, h);
+  const auto with_bar = amalgam::read_image((d / "with_bar.png").string(), bw, bh);
+  const auto bar = amalgam::read_image((d / "bar.png").string(), lw, lh);
+  EXPECT_EQ(w, 40);
+  EXPECT_EQ(h, 30);
+  EXPECT_GT(bh, 30);
+  EXPECT_TRUE(std::equal(apart.begin(), apart.end(), with_bar.begin()))
+      << "the same colours as the picture above the bar";
+  EXPECT_GE(lw, 40);
+  EXPECT_GT(lh, 6);
+  // A legend that is not a PNG, or without a PNG cost image: refused before any work.
+  for (const std::string& bad :
+       {" --cost-image " + (d / "c.png").string() + " --cost-legend " + (d / "bar.pfm").string(),
+        " --cost-image " + (d / "c.pfm").string() + " --cost-legend " + (d / "bar2.png").string(),
+        " --cost-legend " + (d / "bar3.png").string()}) {
+    EXPECT_EQ(amalgam(a + (d / "x.png").string() + bad).status, 2) << bad;
+    EXPECT_FALSE(fs::exists(d / "x.png")) << bad;
+  }
+}
+
 }  // namespace outputs
 }  // namespace

@@ -74,23 +74,42 @@ double write_render_exr(const std::string& path, const RenderOutput& r, const Im
   return top;
 }
 
-void write_cost_image(const std::string& path, const RenderOutput& r, const LogRange& range) {
+void write_cost_image(const std::string& path, const RenderOutput& r, const LogRange& range,
+                      const std::string& legend) {
   if (is_png_path(path)) {
+    const std::string title = "intersection tests per sample, log scale";
     int h = 0;
-    Canvas c{r.width, 0, with_colour_bar(log_colours(r.cost, range), r.width, r.height, range, h)};
-    c.height = h;
-    append_labels(c, log_bar_labels(range, r.width), "intersection tests per sample, log scale",
-                  "tests/sample (log)");
-    write_image(path, c.width, c.height, c.pixels,
-                {{"Software", std::string("amalgam ") + version()},
-                 {"amalgam:cost-range", number(range.min) + "," + number(range.max)},
-                 {"amalgam:cost-scale", "log"},
-                 {"amalgam:cost-unit", "intersection tests per primary sample"},
-                 {"Description",
-                  "intersection tests per primary sample (its shadow rays included), mean over "
-                  "the pixel's samples, viridis on a log scale from " +
-                      number(range.min) + " to " + number(range.max) +
-                      "; below the picture: the colour bar, its numbers and its title"}});
+    Canvas c{r.width, 0, {}};
+    if (legend.empty()) {
+      c.pixels = with_colour_bar(log_colours(r.cost, range), r.width, r.height, range, h);
+      c.height = h;
+      append_labels(c, log_bar_labels(range, r.width), title, "tests/sample (log)");
+    } else {
+      c.pixels = log_colours(r.cost, range), c.height = r.height;
+    }
+    const std::string range_text = number(range.min) + "," + number(range.max);
+    write_image(
+        path, c.width, c.height, c.pixels,
+        {{"Software", std::string("amalgam ") + version()},
+         {"amalgam:cost-range", range_text},
+         {"amalgam:cost-scale", "log"},
+         {"amalgam:cost-unit", "intersection tests per primary sample"},
+         {"Description",
+          "intersection tests per primary sample (its shadow rays included), mean over "
+          "the pixel's samples, viridis on a log scale from " +
+              number(range.min) + " to " + number(range.max) +
+              (legend.empty() ? "; below the picture: the colour bar, its numbers and its title"
+                              : "; the colour bar: " + legend)}});
+    if (!legend.empty()) {
+      const int width = std::max(r.width, 240);  // room for the numbers of a small film
+      Canvas bar{width, 0, with_colour_bar({}, width, 0, range, h)};
+      bar.height = h;
+      append_labels(bar, log_bar_labels(range, width), title, "tests/sample (log)");
+      write_image(legend, bar.width, bar.height, bar.pixels,
+                  {{"Software", std::string("amalgam ") + version()},
+                   {"amalgam:cost-range", range_text},
+                   {"Description", "the colour bar of the cost image " + path}});
+    }
     return;
   }
   std::vector<float> raw(r.cost.size());

@@ -25,9 +25,12 @@ double write_render_exr(const std::string& path, const RenderOutput& r, const Im
                         bool counted = true);
 
 /// The cost image: .png in viridis on the log scale of `range` (tests per primary sample, the
-/// mean over the pixel's samples) with a colour bar appended below (colormap.h) and the range
-/// as tEXt metadata; .pfm/.exr the raw mean tests per sample, grey.
-void write_cost_image(const std::string& path, const RenderOutput& r, const LogRange& range);
+/// mean over the pixel's samples) with the range as tEXt metadata and, unless `legend` names a
+/// PNG of its own for it, a colour bar appended below (colormap.h); with `legend`, the PNG is
+/// the film's size (it overlays the image) and `legend` holds the bar, its numbers and title.
+/// .pfm/.exr: the raw mean tests per sample, grey, film-sized.
+void write_cost_image(const std::string& path, const RenderOutput& r, const LogRange& range,
+                      const std::string& legend = {});
 
 /// The colours of the rendered-level picture: levels in viridis from level 0 to `max_level`
 /// (linear), primitives light grey, nothing black.
