@@ -459,8 +459,17 @@ def advise_values(amalgam, tmp):
         out = subprocess.run([amalgam, "advise", *args, "--json", "-"], check=True,
                              capture_output=True, text=True).stdout
         j = json.loads(out)
+        names = {}
         for r in j["renderers"]:
-            v[f"advise.{view}.{r['key']}"] = f"{r['vs_full_detail']:.2f}x"
+            names[r["key"]] = r["name"]
+            v[f"advise.{view}.{r['key']}"] = (f"{r['vs_full_detail']:.2f}x "
+                                              f"({r['vs_full_detail_low']:.2f}-"
+                                              f"{r['vs_full_detail_high']:.2f})")
+        q = j["level_of_detail_vs_full_detail"]
+        v[f"advise.{view}.lod"] = names[j["best_level_of_detail"]]
+        v[f"advise.{view}.full"] = names[j["best_full_detail"]]
+        v[f"advise.{view}.lod_vs_full"] = f"{q['value']:.2f}x ({q['low']:.2f}-{q['high']:.2f})"
+        v[f"advise.{view}.verdict"] = j["verdict"]
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
                             capture_output=True, text=True).stdout.strip() or "unknown"
     v["advise.stamp"] = (f"{platform.node()}, {os.cpu_count()} cores, "
