@@ -24,6 +24,14 @@ std::string fixed(double v, int digits) {
   return buf;
 }
 
+/// A ratio as the table prints it: two decimals, or two significant digits below 0.1.
+std::string ratio(double v) {
+  if (v >= 0.1) return fixed(v, 2);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2g", v);
+  return buf;
+}
+
 double mse(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
   double s = 0;
   for (std::size_t i = 0; i < a.size(); ++i)
@@ -207,25 +215,24 @@ void report(std::ostream& log, const std::vector<Measured>& ms, const Verdict& v
                                   ? fixed(m.out.per_primary.mean(), 1)
                                   : std::string("-");
     const std::string interval =
-        repeats > 1 ? " (" + fixed(m.vs_full.low, 2) + "-" + fixed(m.vs_full.high, 2) + ")" : "";
-    std::snprintf(row, sizeof row, "%-26s %6d %9.3f %8.3f %9s %9s %9.5f %7.2fx%-13s\n",
+        repeats > 1 ? " (" + ratio(m.vs_full.low) + "-" + ratio(m.vs_full.high) + ")" : "";
+    std::snprintf(row, sizeof row, "%-26s %6d %9.3f %8.3f %9s %9s %9.5f %7sx%-15s\n",
                   m.c.name.c_str(), m.out.spp, m.seconds(), m.setup_s, mib(m.setup_bytes).c_str(),
-                  tests.c_str(), m.rmse(), m.vs_full.value, interval.c_str());
+                  tests.c_str(), m.rmse(), ratio(m.vs_full.value).c_str(), interval.c_str());
     log << row;
   }
   log << "\n\"vs full det.\": full detail's MSE x time over this renderer's (above 1: lower "
          "error in the same time).\n";
   const Measured& best = ms[v.best];
-  log << "Best error per time on this view: " << best.c.name << " (" << fixed(best.vs_full.value, 2)
+  log << "Best error per time on this view: " << best.c.name << " (" << ratio(best.vs_full.value)
       << "x)";
   for (std::size_t i = 0; i < v.tied.size(); ++i)
     log << (i == 0 ? "; tied within the intervals: " : ", ") << ms[v.tied[i]].c.name;
   log << ".\n";
   const Measured &lod = ms[v.best_lod], &full = ms[v.best_full];
   const Ratio& q = v.lod_vs_full;
-  const std::string against = lod.c.name + " against " + full.c.name + ": " + fixed(q.value, 2) +
-                              "x" +
-                              (repeats > 1 ? " (" + fixed(q.low, 2) + "-" + fixed(q.high, 2) + ")"
+  const std::string against = lod.c.name + " against " + full.c.name + ": " + ratio(q.value) + "x" +
+                              (repeats > 1 ? " (" + ratio(q.low) + "-" + ratio(q.high) + ")"
                                            : std::string(" (one repeat: no interval)"));
   if (v.outcome == "pays off")
     log << "Amalgams pay off on this view: " << against << ".\n";
