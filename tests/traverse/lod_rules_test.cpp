@@ -110,7 +110,8 @@ TEST(LodRules, FixedLevelRendersTheAmalgamHoldingTheRayOrigin) {
   for (bool reference : {false, true}) {
     SCOPED_TRACE(reference ? "reference traversal" : "fast traversal");
     // Level 1 (the two amalgams): a ray starting inside the right one renders it, at once.
-    const Outcome in_right = run(reference, h, ScaleSensitiveLod::on_level(1), wide_ray({1.5f, 0, 0}));
+    const Outcome in_right =
+        run(reference, h, ScaleSensitiveLod::on_level(1), wide_ray({1.5f, 0, 0}));
     EXPECT_EQ(in_right.transmittance, 0.0f) << "--level never passes the level";
     ASSERT_EQ(in_right.hit.kind, TraceHit::Kind::kAmalgam);
     EXPECT_LE(in_right.hit.t, 0.0f + 1e-6f);
