@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "amalgam/analysis/metrics.h"
 #include "amalgam/render/option_rules.h"
 #include "amalgam/render/tracer.h"
 #include "amalgam/scene/coordinate_limit.h"
@@ -71,6 +72,11 @@ std::shared_ptr<RenderResult> make_result(const LoadedScene& scene, const Render
       return view<float>(std::vector<Vec3>{}, {0, 0, 3});
     return view<float>(std::move(v), {h, w, 3});
   };
+  // A view that shows almost nothing says so, as the CLI's warning line does.
+  if (whole)
+    if (const std::string dark = dark_view(r.image, r.depth); !dark.empty())
+      py::module_::import("warnings")
+          .attr("warn")(dark, py::module_::import("builtins").attr("RuntimeWarning"), 2);
   res->image = rgb(std::move(r.image));
   res->normal = rgb(std::move(r.normal));
   res->albedo = rgb(std::move(r.albedo));

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "amalgam/analysis/metrics.h"
 #include "amalgam/render/option_rules.h"
 #include "amalgam/render/tracer.h"
 #include "amalgam/scene/coordinate_limit.h"
@@ -86,25 +87,7 @@ void CommonOptions::prepare(LoadedScene& scene) const {
 }
 
 std::string dark_view(const RenderOutput& r) {
-  constexpr float kDark = 0.02f;
-  bool hit = false;
-  float brightest = 0.0f;
-  for (std::size_t i = 0; i < r.image.size(); ++i) {
-    if (i < r.depth.size() && !std::isfinite(r.depth[i])) continue;  // a miss: the background
-    hit = true;
-    const Vec3 c = r.image[i];
-    brightest = std::max({brightest, c.x, c.y, c.z});
-  }
-  if (r.image.empty()) return {};
-  if (!hit)
-    return "no camera ray met the scene: the view looks away from it (`amalgam info` prints its "
-           "bounds and cameras; --camera, --eye, --look-at set the view)";
-  if (brightest >= kDark) return {};
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.3g", brightest);
-  return std::string("almost no light reaches what the camera sees (brightest pixel ") + buf +
-         "): the view may face the unlit side, or the file's lights be too weak for its size "
-         "(`amalgam info` lists them; docs/import.md, light units)";
+  return amalgam::dark_view(r.image, r.depth);
 }
 
 void print_warnings(const LoadedScene& scene) {

@@ -4,6 +4,7 @@ import json
 import pathlib
 import subprocess
 import threading
+import warnings
 
 import numpy as np
 import pytest
@@ -324,3 +325,20 @@ def test_progress_callback(demo):
     with pytest.raises(TypeError) as e:
         demo.render(width=8, height=8, progress=3)
     assert str(e.value) == "Scene.render() argument 'progress' must be callable or None, not int"
+
+
+def test_a_view_that_shows_nothing_is_a_runtime_warning():
+    """The CLI's warning line, as Python's warnings: Blender's default cube (a lamp of intensity
+    1 seven units away: brightest pixel 0.0072) and a view away from the Wuson; a lit view warns
+    of nothing."""
+    models = pathlib.Path("/usr/share/assimp/models")
+    cube = amalgam.load(models / "BLEND/BlenderDefault_276.blend")
+    with pytest.warns(RuntimeWarning, match=r"^almost no light reaches what the camera sees"):
+        cube.render(width=32, height=24, spp=1)
+    wuson = amalgam.load(models / "PLY/Wuson.ply")
+    with pytest.warns(RuntimeWarning, match=r"^no camera ray met the scene"):
+        wuson.render(width=32, height=24, spp=1, eye=(0, 0, 5), look_at=(0, 0, 10))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r = wuson.render(width=32, height=24, spp=1)
+    assert r.image.max() > 0.5

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -184,6 +185,28 @@ ImageComparison compare_images(const std::vector<Vec3>& a, const std::vector<Vec
   r.max_abs = mx;
   r.rel_mse = rel_mse(a, b);
   return r;
+}
+
+std::string dark_view(const std::vector<Vec3>& image, const std::vector<float>& depth) {
+  constexpr float kDark = 0.02f;
+  bool hit = false;
+  float brightest = 0.0f;
+  for (std::size_t i = 0; i < image.size(); ++i) {
+    if (i < depth.size() && !std::isfinite(depth[i])) continue;  // a miss: the background
+    hit = true;
+    const Vec3 c = image[i];
+    brightest = std::max({brightest, c.x, c.y, c.z});
+  }
+  if (image.empty()) return {};
+  if (!hit)
+    return "no camera ray met the scene: the view looks away from it (`amalgam info` prints its "
+           "bounds and cameras; the camera, eye and look-at options set the view)";
+  if (brightest >= kDark) return {};
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.3g", brightest);
+  return std::string("almost no light reaches what the camera sees (brightest pixel ") + buf +
+         "): the view may face the unlit side, or the file's lights be too weak for its size "
+         "(`amalgam info` lists them; docs/import.md, light units)";
 }
 
 }  // namespace amalgam

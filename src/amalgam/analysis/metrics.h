@@ -83,6 +83,12 @@ struct ImageComparison {
 /// would come out as SSIM 1 and max error 0).
 std::string non_finite_pixels(const std::vector<Vec3>& image);
 
+/// Why a rendered image shows almost nothing, for a warning, or "": no camera ray met the
+/// scene (every `depth` infinite), or the brightest pixel where one did is below 0.02 in every
+/// channel (a view of the unlit side, or a file's lights too weak for its size). `depth` is
+/// the render's mean primary-hit distance per pixel (empty: every pixel counts as a hit).
+std::string dark_view(const std::vector<Vec3>& image, const std::vector<float>& depth);
+
 /// All the metrics above for two width x height images. Throws MetricsError if either
 /// pixel count differs from width * height.
 ImageComparison compare_images(const std::vector<Vec3>& a, const std::vector<Vec3>& b, int width,
