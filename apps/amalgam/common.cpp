@@ -10,7 +10,6 @@
 #include <sstream>
 #include <system_error>
 
-#include "amalgam/analysis/metrics.h"
 #include "amalgam/render/option_rules.h"
 #include "amalgam/render/tracer.h"
 #include "amalgam/scene/coordinate_limit.h"
@@ -84,10 +83,6 @@ void CommonOptions::add_view_to(CLI::App& app) {
 
 void CommonOptions::prepare(LoadedScene& scene) const {
   choose_camera(scene, view);
-}
-
-std::string dark_view(const RenderOutput& r) {
-  return amalgam::dark_view(r.image, r.depth);
 }
 
 void print_warnings(const LoadedScene& scene) {

@@ -9,7 +9,6 @@
 #include "amalgam/load/load_scene.h"
 #include "amalgam/math/vec.h"
 #include "amalgam/render/options.h"
-#include "amalgam/render/render.h"
 
 // Declared, not included: CLI11's header costs about 8 s of compile time at -O3 in every file
 // that includes it (it defines its validators in each), and only the files that build the
@@ -124,11 +123,6 @@ struct AdviseOptions {
   std::string keep;         ///< a directory for every render and the reference (PFM)
 };
 int run_advise(CommonOptions& common, const AdviseOptions& advise);
-
-/// Why an image shows almost nothing, for a warning, or empty: no camera ray met the scene,
-/// or the brightest pixel where one did is below 0.02 in every channel (a view from the
-/// unlit side, or a file's lights too weak for its scale).
-std::string dark_view(const RenderOutput& r);
 
 /// `info`: the scene's bounds, primitives, instances, cameras and lights, and the view a
 /// render would use (as text, or JSON with `as_json`). Loads the scene without baking.

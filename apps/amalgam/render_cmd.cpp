@@ -15,6 +15,7 @@
 #include <optional>
 #include <sstream>
 
+#include "amalgam/analysis/metrics.h"
 #include "amalgam/hierarchy/build/build.h"
 #include "amalgam/io/checkpoint.h"
 #include "amalgam/io/colormap.h"
@@ -248,7 +249,7 @@ void finish_complete(const RenderExtras& extra, const std::string& ckpt, const P
       std::filesystem::remove(t.path, ec);
   } catch (const InputError&) {  // its directory went away meanwhile: nothing to remove
   }
-  if (const std::string dark = dark_view(r); !dark.empty())
+  if (const std::string dark = dark_view(r.image, r.depth); !dark.empty())
     std::cerr << "amalgam: warning: " << extra.out << ": " << dark << "\n";
   if (extra.quiet) return;
   std::cerr << "amalgam: wrote " << extra.out << " (" << r.width << "x" << r.height << ", " << r.spp
