@@ -118,23 +118,22 @@ void check_range(std::string_view name, const py::int_& v, const py::int_& lo, c
 
 }  // namespace
 
-std::int64_t Args::integer(std::string_view name, std::int64_t lo, std::int64_t hi) const {
+py::int_ Args::index_in(std::string_view name, const py::int_& lo, const py::int_& hi) const {
   const py::object& v = (*this)[name];
   if (PyBool_Check(v.ptr()) || !PyIndex_Check(v.ptr())) wrong_type(name, "int");
   const auto i = py::reinterpret_steal<py::int_>(PyNumber_Index(v.ptr()));
   if (!i) throw py::error_already_set();
-  check_range(name, i, py::int_(lo), py::int_(hi));
-  return i.cast<std::int64_t>();
+  check_range(name, i, lo, hi);
+  return i;
+}
+
+std::int64_t Args::integer(std::string_view name, std::int64_t lo, std::int64_t hi) const {
+  return index_in(name, py::int_(lo), py::int_(hi)).cast<std::int64_t>();
 }
 
 std::uint64_t Args::unsigned_integer(std::string_view name, std::uint64_t lo,
                                      std::uint64_t hi) const {
-  const py::object& v = (*this)[name];
-  if (PyBool_Check(v.ptr()) || !PyIndex_Check(v.ptr())) wrong_type(name, "int");
-  const auto i = py::reinterpret_steal<py::int_>(PyNumber_Index(v.ptr()));
-  if (!i) throw py::error_already_set();
-  check_range(name, i, py::int_(lo), py::int_(hi));
-  return i.cast<std::uint64_t>();
+  return index_in(name, py::int_(lo), py::int_(hi)).cast<std::uint64_t>();
 }
 
 std::optional<std::int64_t> Args::optional_integer(std::string_view name, std::int64_t lo,

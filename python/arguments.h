@@ -77,6 +77,8 @@ class Args {
   [[noreturn]] void wrong_type(std::string_view name, std::string_view want) const;
 
  private:
+  /// The integer given for `name` (the checks of `integer`) within [lo, hi].
+  py::int_ index_in(std::string_view name, const py::int_& lo, const py::int_& hi) const;
   std::string function_;
   std::vector<Param> params_;
   std::vector<py::object> values_;

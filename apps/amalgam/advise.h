@@ -84,7 +84,4 @@ void write_json(const AdviseOptions& a, const std::string& scene, double budget,
                 const RenderOutput& ref, const std::vector<Measured>& ms, const Verdict& v,
                 double scene_bytes);
 
-/// The process's resident set in bytes (/proc/self/statm), 0 where unknown.
-double resident_bytes();
-
 }  // namespace amalgam::cli::advise

@@ -167,14 +167,14 @@ int run_advise(CommonOptions& common, const AdviseOptions& a) {
   check_files_spare_inputs(advise_outputs(a, common.options), scene);
   common.prepare(scene);
   print_warnings(scene);
-  const double scene_bytes = advise::resident_bytes();
+  const double scene_bytes = resident_bytes();
   advise::Scenes scenes{&scene, nullptr, 0};
   if (!scene.inputs.empty()) {  // a scene file or mesh: its objects for the volumetric renderer
     set_activity("loading the objects of " + common.scene + " for the volumetric renderer");
     config.objects = true, config.amalgams = false;
     auto objects = std::make_shared<LoadedScene>(load_scene(common.scene, common.params(), config));
     common.prepare(*objects);
-    scenes.objects_bytes = std::max(0.0, advise::resident_bytes() - scene_bytes);
+    scenes.objects_bytes = std::max(0.0, resident_bytes() - scene_bytes);
     if (objects->volumes) scenes.objects = std::move(objects);
   }
 

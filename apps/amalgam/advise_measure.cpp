@@ -1,12 +1,9 @@
 // `amalgam advise`'s measurement, table and verdict (advise.h).
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
@@ -103,13 +100,6 @@ double Measured::seconds() const {
   return s;
 }
 
-double resident_bytes() {
-  std::ifstream statm("/proc/self/statm");
-  double pages = 0.0, resident = 0.0;
-  if (!(statm >> pages >> resident)) return 0.0;
-  return resident * static_cast<double>(sysconf(_SC_PAGE_SIZE));
-}
-
 std::vector<Candidate> candidates(const RenderOptions& base) {
   std::vector<Candidate> out;
   RenderOptions o = base;
@@ -144,10 +134,11 @@ std::vector<Measured> measure(const Scenes& s, const RenderOptions& base, const 
     if (volumetric && !s.objects) continue;
     const LoadedScene& scene = volumetric ? *s.objects : *s.scene;
     set_activity("setting up " + c.name);
-    const double before = resident_bytes();
+    const double before = amalgam::resident_bytes();
     tracers.push_back(make_tracer(scene, c.options));
     Measured m{c, {}, {}, 0, 0, {}};
-    m.setup_bytes = std::max(0.0, resident_bytes() - before) + (volumetric ? s.objects_bytes : 0);
+    m.setup_bytes =
+        std::max(0.0, amalgam::resident_bytes() - before) + (volumetric ? s.objects_bytes : 0);
     m.setup_s = scene.build_seconds + tracers.back()->build_seconds() +
                 (c.options.renderer() == RendererKind::kScaleSensitive ? scene.bake_seconds : 0.0) +
                 (volumetric ? scene.volume_seconds : 0.0);

@@ -75,15 +75,14 @@ SceneDescription mesh_scene(const std::string& path, const SceneFileConfig& conf
   return d;
 }
 
-namespace {
-
-/// The bytes this process holds in memory now (its resident set, /proc/self/statm).
 double resident_bytes() {
   std::ifstream statm("/proc/self/statm");
   double pages = 0.0, resident = 0.0;
   if (!(statm >> pages >> resident)) return 0.0;
   return resident * static_cast<double>(sysconf(_SC_PAGE_SIZE));
 }
+
+namespace {
 
 /// Reads a scene with `read` and builds and bakes it: the work of load_scene_path, for a file
 /// (`path` its name, and the first of the inputs) or for text (`path` names it in messages).

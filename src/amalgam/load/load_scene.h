@@ -57,6 +57,10 @@ void choose_camera(LoadedScene& scene, const CameraChoice& choice);
 /// view of one built, baked scene (render's `env` overload, render/render.h). Same errors.
 Environment chosen_view(const LoadedScene& scene, const CameraChoice& choice);
 
+/// The bytes this process holds in memory now (its resident set, /proc/self/statm); 0 where
+/// unknown. What the loader charges a scene's bake against.
+double resident_bytes();
+
 /// Loads `spec`. Throws InputError (one line naming the scene and the problem) on bad input,
 /// including a scene file or mesh that would take more than `config.max_bytes` (checked before
 /// building; the builtin scenes are implicit and take no memory to speak of).
